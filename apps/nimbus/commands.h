@@ -1,0 +1,25 @@
+// The nimbus CLI: each subcommand lives in its own cmd_*.cpp and registers itself here.
+// A subcommand's callback stores the action to run after parsing; main() runs it and turns
+// nimbus::Error into a message on stderr and exit code 2.
+#pragma once
+
+#include <functional>
+
+#include <CLI/CLI.hpp>
+
+namespace nimbus::cli {
+
+using Action = std::function<int()>;
+
+void add_render_command(CLI::App& app, Action& action);
+void add_compare_command(CLI::App& app, Action& action);
+void add_info_command(CLI::App& app, Action& action);
+void add_beam_command(CLI::App& app, Action& action);
+void add_slab_command(CLI::App& app, Action& action);
+
+// Exit codes.
+inline constexpr int kExitOk = 0;
+inline constexpr int kExitFailure = 1;    // the run itself failed (I/O error writing, cancelled)
+inline constexpr int kExitBadInput = 2;   // bad arguments, scene, volume or image
+
+}  // namespace nimbus::cli

@@ -1,0 +1,44 @@
+// nimbus: the command-line front end. The only code that prints or exits.
+#include <cstdio>
+#include <exception>
+
+#include <fmt/format.h>
+
+#include "commands.h"
+#include "nimbus/error.h"
+
+int main(int argc, char** argv) {
+  using namespace nimbus::cli;
+  CLI::App app{"nimbus: a renderer for forward-scattering participating media (clouds, smoke, fog, "
+               "skin, water), with the multiple-forward-scattering model judged against an unbiased "
+               "path tracer."};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "nimbus 0.1.0");
+  Action action;
+  add_render_command(app, action);
+  add_compare_command(app, action);
+  add_info_command(app, action);
+  add_beam_command(app, action);
+  add_slab_command(app, action);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int rc = app.exit(e);
+    return rc == 0 ? kExitOk : kExitBadInput;
+  }
+  try {
+    return action ? action() : kExitOk;
+  } catch (const nimbus::Cancelled& e) {
+    fmt::print(stderr, "nimbus: cancelled\n");
+    return kExitFailure;
+  } catch (const nimbus::Error& e) {
+    fmt::print(stderr, "nimbus: error: {}\n", e.what());
+    return kExitBadInput;
+  } catch (const std::bad_alloc&) {
+    fmt::print(stderr, "nimbus: error: out of memory\n");
+    return kExitFailure;
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "nimbus: internal error: {}\n", e.what());
+    return kExitFailure;
+  }
+}

@@ -1,0 +1,89 @@
+// Small vector math on top of Imath (V3d is the position/direction type, Rgb the colour type).
+#pragma once
+
+#include <Imath/ImathVec.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+namespace nimbus {
+
+using Vec3 = Imath::V3d;
+using Rgb = Imath::V3d;  // linear RGB radiance or per-channel coefficients
+
+inline constexpr double kPi = std::numbers::pi;
+inline constexpr double kInvPi = 1.0 / std::numbers::pi;
+inline constexpr double kInv4Pi = 1.0 / (4.0 * std::numbers::pi);
+
+inline double dot(const Vec3& a, const Vec3& b) { return a.dot(b); }
+inline Vec3 cross(const Vec3& a, const Vec3& b) { return a.cross(b); }
+inline double length(const Vec3& a) { return a.length(); }
+inline Vec3 normalize(const Vec3& a) { return a / a.length(); }
+
+inline double max_component(const Rgb& c) { return std::max({c.x, c.y, c.z}); }
+inline double min_component(const Rgb& c) { return std::min({c.x, c.y, c.z}); }
+inline double average(const Rgb& c) { return (c.x + c.y + c.z) / 3.0; }
+inline double luminance(const Rgb& c) { return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z; }
+inline Rgb exp(const Rgb& c) { return {std::exp(c.x), std::exp(c.y), std::exp(c.z)}; }
+inline bool is_finite(const Rgb& c) {
+  return std::isfinite(c.x) && std::isfinite(c.y) && std::isfinite(c.z);
+}
+
+// An orthonormal frame (s, t, n) around a unit vector n (Duff et al. 2017, branchless).
+struct Frame {
+  Vec3 s, t, n;
+  explicit Frame(const Vec3& n_) : n(n_) {
+    const double sign = std::copysign(1.0, n.z);
+    const double a = -1.0 / (sign + n.z);
+    const double b = n.x * n.y * a;
+    s = Vec3(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x);
+    t = Vec3(b, sign + n.y * n.y * a, -n.y);
+  }
+  Vec3 to_world(const Vec3& v) const { return s * v.x + t * v.y + n * v.z; }
+  Vec3 to_local(const Vec3& v) const { return {dot(v, s), dot(v, t), dot(v, n)}; }
+};
+
+// Direction with polar cosine cos_theta around axis n and azimuth phi.
+inline Vec3 spherical_direction(double cos_theta, double phi, const Vec3& n) {
+  const double sin_theta = std::sqrt(std::max(0.0, 1.0 - cos_theta * cos_theta));
+  return Frame(n).to_world({sin_theta * std::cos(phi), sin_theta * std::sin(phi), cos_theta});
+}
+
+// Axis-aligned box.
+struct Bounds {
+  Vec3 lo{std::numeric_limits<double>::infinity()};
+  Vec3 hi{-std::numeric_limits<double>::infinity()};
+  bool empty() const { return !(lo.x <= hi.x && lo.y <= hi.y && lo.z <= hi.z); }
+  void extend(const Vec3& p) {
+    lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
+    hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
+  }
+  void extend(const Bounds& b) {
+    if (!b.empty()) { extend(b.lo); extend(b.hi); }
+  }
+  bool overlaps(const Bounds& b) const {
+    return lo.x <= b.hi.x && b.lo.x <= hi.x && lo.y <= b.hi.y && b.lo.y <= hi.y && lo.z <= b.hi.z &&
+           b.lo.z <= hi.z;
+  }
+  bool contains(const Vec3& p) const {
+    return p.x >= lo.x && p.x <= hi.x && p.y >= lo.y && p.y <= hi.y && p.z >= lo.z && p.z <= hi.z;
+  }
+  // Slab test: the parametric interval [t0, t1] of the ray inside the box, clipped to [tmin, tmax].
+  bool intersect(const Vec3& o, const Vec3& d, double tmin, double tmax, double* t0, double* t1) const {
+    for (int a = 0; a < 3; ++a) {
+      const double inv = 1.0 / d[a];
+      double tn = (lo[a] - o[a]) * inv, tf = (hi[a] - o[a]) * inv;
+      if (tn > tf) std::swap(tn, tf);
+      if (!(tn <= tf)) return false;  // NaN when o on the slab plane and d[a] == 0
+      tmin = std::max(tmin, tn);
+      tmax = std::min(tmax, tf);
+      if (tmin > tmax) return false;
+    }
+    *t0 = tmin;
+    *t1 = tmax;
+    return true;
+  }
+};
+
+}  // namespace nimbus
