@@ -1,0 +1,44 @@
+// Rendering a scene: options, progress and cancellation callbacks, the result.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+
+#include "nimbus/image.h"
+#include "nimbus/scene.h"
+
+namespace nimbus {
+
+struct RenderOptions {
+  std::optional<int> spp;               // overrides the scene's integrator.spp
+  std::optional<uint64_t> seed;         // overrides integrator.seed
+  std::optional<std::string> integrator;  // overrides integrator.type
+  int threads = 0;                      // 0 = all hardware threads
+  int tile_size = 16;
+  // Called from worker threads as tiles finish: (tiles done, tiles total, samples so far).
+  std::function<void(int64_t done, int64_t total, int64_t samples)> progress;
+  // Set to true (e.g. from a signal handler) to stop at the next tile.
+  const std::atomic<bool>* cancel = nullptr;
+};
+
+struct RenderResult {
+  Image image;
+  bool partial = false;           // cancelled: tiles not rendered are black
+  int64_t tiles_done = 0, tiles_total = 0;
+  int64_t nonfinite_samples = 0;  // NaN/inf samples found and dropped by the film
+  double seconds = 0.0;
+  std::string integrator;
+  int spp = 0;
+  uint64_t seed = 0;
+  ImageMetadata metadata;  // scene and settings, for the EXR header
+};
+
+// Names of the available integrators.
+std::vector<std::string> integrator_names();
+
+RenderResult render(const Scene& scene, const RenderOptions& options = {});
+
+}  // namespace nimbus

@@ -1,0 +1,103 @@
+#include "integrators/pathtrace.h"
+
+#include "integrators/tracking.h"
+#include "render/lights.h"
+
+namespace nimbus {
+
+Rgb PathTracer::sample(double px, double py, Rng& rng) const {
+  return radiance(ctx_.camera.origin(), ctx_.camera.direction(px, py), rng);
+}
+
+Rgb PathTracer::direct_light(const Vec3& p, const Vec3& d, int medium, Rng& rng) const {
+  const Phase& phase = ctx_.media.phase(medium);
+  Rgb L(0.0);
+  // Lights with a sampled direction: weight = radiance / pdf.
+  for (const Light& light : ctx_.lights) {
+    LightSample ls;
+    const double u1 = rng.uniform(), u2 = rng.uniform();
+    if (!sample_light(light, p, u1, u2, &ls)) continue;
+    const double f = phase_eval(phase, dot(d, ls.wi));
+    if (f <= 0.0) continue;
+    const Rgb T = ratio_tracking_transmittance(ctx_.media, ctx_.majorants, p, ls.wi, ls.distance, rng);
+    L += ls.weight * T * f;
+  }
+  // The environment through a phase-sampled direction: f / pdf = 1.
+  if (ctx_.has_environment) {
+    const double u1 = rng.uniform(), u2 = rng.uniform();
+    const Vec3 wi = phase_sample(phase, d, u1, u2);
+    const Rgb T = ratio_tracking_transmittance(ctx_.media, ctx_.majorants, p, wi,
+                                               std::numeric_limits<double>::infinity(), rng);
+    L += ctx_.environment * T;
+  }
+  return L;
+}
+
+Rgb PathTracer::radiance(const Vec3& origin, const Vec3& direction, Rng& rng) const {
+  Rgb L(0.0), beta(1.0);
+  Vec3 o = origin, d = direction;
+  MediumPoint mp;
+  for (int events = 0;; ++events) {
+    // Delta tracking to the next real scattering event.
+    int scatter_medium = -1;
+    Vec3 scatter_p;
+    const bool escaped = track(ctx_.majorants, o, d, std::numeric_limits<double>::infinity(), rng,
+                               [&](const Vec3& p, double maj) {
+      ctx_.media.eval(p, &mp);
+      const Rgb sigma_n = Rgb(maj) - mp.sigma_t();
+      // Event probabilities from throughput-weighted channel sums (history-aware spectral tracking,
+      // which keeps the per-channel weights bounded); absorption is carried as weight, not sampled.
+      const double p_null = std::max(0.0, dot(beta, sigma_n));
+      double p_scatter = 0.0;
+      for (int i = 0; i < mp.count; ++i) p_scatter += dot(beta, mp.sigma_s_i[i]);
+      const double total = p_null + p_scatter;
+      if (total <= 0.0) {  // pure absorber at the majorant: the path ends here
+        beta = Rgb(0.0);
+        return false;
+      }
+      double u = rng.uniform() * total;
+      if (u < p_null) {
+        beta *= sigma_n * (total / (maj * p_null));
+        return true;
+      }
+      u -= p_null;
+      for (int i = 0; i < mp.count; ++i) {
+        const double pi = dot(beta, mp.sigma_s_i[i]);
+        if (pi <= 0.0) continue;
+        if (u < pi || i == mp.count - 1) {
+          beta *= mp.sigma_s_i[i] * (total / (maj * pi));
+          scatter_medium = i;
+          scatter_p = p;
+          return false;
+        }
+        u -= pi;
+      }
+      return false;
+    });
+    if (escaped) {
+      // Only camera rays see the environment directly; later escapes were counted by NEE.
+      if (events == 0 && ctx_.has_environment) L += beta * ctx_.environment;
+      break;
+    }
+    if (scatter_medium < 0 || max_component(beta) <= 0.0) break;
+
+    // Next-event estimation at the scattering vertex.
+    L += beta * direct_light(scatter_p, d, scatter_medium, rng);
+    if (max_events_ > 0 && events + 1 >= max_events_) break;
+
+    // Continue in a phase-sampled direction (weight f / pdf = 1).
+    const double u1 = rng.uniform(), u2 = rng.uniform();
+    d = phase_sample(ctx_.media.phase(scatter_medium), d, u1, u2);
+    o = scatter_p;
+
+    // Russian roulette on the largest channel of the throughput.
+    if (events >= 3) {
+      const double q = std::min(1.0, max_component(beta));
+      if (rng.uniform() >= q) break;
+      beta /= q;
+    }
+  }
+  return L;
+}
+
+}  // namespace nimbus

@@ -1,0 +1,61 @@
+// The one tracking kernel (after pbrt-v4's SampleT_maj): tentative collisions distributed with the
+// majorant density, cell by cell of the majorant grid. Delta tracking (pathtrace), ratio tracking
+// (transmittance) and the other integrators all build on it.
+#pragma once
+
+#include <cmath>
+
+#include "core/rng.h"
+#include "media/majorant.h"
+#include "media/media.h"
+
+namespace nimbus {
+
+// Calls on_collision(p, majorant) -> bool at tentative collisions along o + t d (d unit), t in
+// (0, tmax). Returns true when the ray reached tmax (or left the media), false when the callback
+// stopped it.
+template <typename F>
+bool track(const MajorantGrid& grid, const Vec3& o, const Vec3& d, double tmax, Rng& rng, F&& on_collision) {
+  bool reached_end = true;
+  grid.traverse(o, d, 0.0, tmax, [&](double t0, double t1, double maj) {
+    if (maj <= 0.0) return true;
+    double t = t0;
+    while (true) {
+      // Exponential step; memorylessness lets each cell restart at its entry.
+      t -= std::log1p(-rng.uniform()) / maj;
+      if (t >= t1) return true;
+      if (!on_collision(o + d * t, maj)) {
+        reached_end = false;
+        return false;
+      }
+    }
+  });
+  return reached_end;
+}
+
+// Unbiased per-channel transmittance along o + t d, t in (0, tmax), by ratio tracking with
+// Russian roulette once every channel has fallen below 0.1.
+inline Rgb ratio_tracking_transmittance(const SceneMedia& media, const MajorantGrid& grid, const Vec3& o,
+                                        const Vec3& d, double tmax, Rng& rng) {
+  Rgb T(1.0);
+  track(grid, o, d, tmax, rng, [&](const Vec3& p, double maj) {
+    const Rgb sigma_t = media.sigma_t(p);
+    T *= Rgb(1.0) - sigma_t / maj;
+    const double m = max_component(T);
+    if (m <= 0.0) {
+      T = Rgb(0.0);
+      return false;
+    }
+    if (m < 0.1) {
+      if (rng.uniform() < 0.5) {
+        T = Rgb(0.0);
+        return false;
+      }
+      T *= 2.0;
+    }
+    return true;
+  });
+  return T;
+}
+
+}  // namespace nimbus

@@ -1,0 +1,191 @@
+// Scene JSON: parsing and validation (docs/scene-format.md is the user-facing description).
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include <fmt/format.h>
+
+#include "io/json_reader.h"
+#include "io/scene_volumes.h"
+#include "nimbus/error.h"
+#include "nimbus/scene.h"
+
+namespace nimbus {
+
+namespace {
+
+Vec3 unit_direction(JsonObject& o, const std::string& key) {
+  const Vec3 d = o.vec3(key);
+  const double len = length(d);
+  if (!(len > 1e-12)) o.fail(key, "must have non-zero length");
+  return d / len;
+}
+
+double g_value(JsonObject& o, const std::string& key, double fallback) {
+  const double g = o.number(key, -1e300, 1e300, fallback);
+  if (!(std::abs(g) < 1.0)) o.fail(key, "must satisfy |g| < 1");
+  return g;
+}
+
+Phase parse_phase(JsonObject o) {
+  const std::string type = o.string("type");
+  Phase phase;
+  if (type == "isotropic") {
+    phase = IsotropicPhase{};
+  } else if (type == "hg") {
+    phase = HgPhase{g_value(o, "g", 0.0)};
+  } else if (type == "double_hg") {
+    DoubleHgPhase p;
+    p.g1 = g_value(o, "g1", 0.0);
+    p.g2 = g_value(o, "g2", 0.0);
+    p.w = o.number("w", 0.0, 1.0);
+    phase = p;
+  } else if (type == "gauss") {
+    phase = make_gauss_phase(o.number_open_below("theta2", 0.0, 100.0));
+  } else {
+    o.fail("type", fmt::format("unknown phase function '{}' (known: isotropic, hg, double_hg, gauss)", type));
+  }
+  o.finish();
+  return phase;
+}
+
+Shape parse_shape(JsonObject o, const std::filesystem::path& base_dir) {
+  const std::string type = o.string("type");
+  Shape shape;
+  if (type == "sphere") {
+    SphereShape s;
+    s.center = o.vec3("center", s.center);
+    s.radius = o.number_open_below("radius", 0.0, 1e30);
+    shape = s;
+  } else if (type == "box") {
+    BoxShape b;
+    b.min = o.vec3("min");
+    b.max = o.vec3("max");
+    for (int a = 0; a < 3; ++a)
+      if (!(b.max[a] > b.min[a])) o.fail("max", "must exceed min on every axis");
+    shape = b;
+  } else if (type == "vdb") {
+    VdbShape v;
+    v.file = o.string("file");
+    v.grid = o.string("grid", "");
+    v.translate = o.vec3("translate", v.translate);
+    v.scale = o.number_open_below("scale", 0.0, 1e30);
+    load_vdb_shape(v, base_dir, o.where(), o.path());
+    shape = v;
+  } else if (type == "cloud") {
+    CloudShape c;
+    c.center = o.vec3("center", c.center);
+    c.radius = o.number_open_below("radius", 0.0, 1e30);
+    c.seed = uint32_t(o.integer("seed", 0, 0xffffffffll, 1));
+    c.resolution = int(o.integer("resolution", 8, 1024, 128));
+    build_cloud_shape(c);
+    shape = c;
+  } else {
+    o.fail("type", fmt::format("unknown shape '{}' (known: sphere, box, vdb, cloud)", type));
+  }
+  o.finish();
+  return shape;
+}
+
+Medium parse_medium(JsonObject o, const std::filesystem::path& base_dir) {
+  Medium m;
+  m.shape = parse_shape(o.object("shape"), base_dir);
+  m.sigma_s = o.rgb("sigma_s", 0.0);
+  m.sigma_a = o.rgb("sigma_a", 0.0, Rgb(0.0));
+  m.phase = o.has("phase") ? parse_phase(o.object("phase")) : Phase{IsotropicPhase{}};
+  o.finish();
+  return m;
+}
+
+Light parse_light(JsonObject o) {
+  const std::string type = o.string("type");
+  Light light;
+  if (type == "directional") {
+    DirectionalLight d;
+    d.direction = unit_direction(o, "direction");
+    d.irradiance = o.rgb("irradiance", 0.0);
+    d.angular_diameter_deg = o.number("angular_diameter_deg", 0.0, 90.0, 0.0);
+    light = d;
+  } else if (type == "point") {
+    PointLight p;
+    p.position = o.vec3("position");
+    p.intensity = o.rgb("intensity", 0.0);
+    light = p;
+  } else if (type == "environment") {
+    EnvironmentLight e;
+    e.radiance = o.rgb("radiance", 0.0);
+    light = e;
+  } else {
+    o.fail("type", fmt::format("unknown light '{}' (known: directional, point, environment)", type));
+  }
+  o.finish();
+  return light;
+}
+
+Camera parse_camera(JsonObject o) {
+  Camera c;
+  c.position = o.vec3("position");
+  c.look_at = o.vec3("look_at");
+  c.up = o.vec3("up", c.up);
+  c.fov_y_deg = o.number_open_below("fov_y_deg", 0.0, 179.0);
+  c.width = int(o.integer("width", 1, kMaxImageSide));
+  c.height = int(o.integer("height", 1, kMaxImageSide));
+  if (int64_t(c.width) * c.height > kMaxImagePixels)
+    o.fail("height", fmt::format("width x height exceeds the limit of {} pixels", kMaxImagePixels));
+  const Vec3 forward = c.look_at - c.position;
+  if (!(length(forward) > 1e-12)) o.fail("look_at", "must differ from position");
+  if (!(length(c.up) > 1e-12)) o.fail("up", "must have non-zero length");
+  if (length(cross(normalize(forward), normalize(c.up))) < 1e-6)
+    o.fail("up", "must not be parallel to the view direction (look_at - position)");
+  o.finish();
+  return c;
+}
+
+IntegratorSettings parse_integrator(JsonObject o) {
+  IntegratorSettings s;
+  s.type = o.string("type", s.type);
+  s.spp = int(o.integer("spp", 1, kMaxSpp, s.spp));
+  s.max_events = int(o.integer("max_events", 0, 1000000, s.max_events));
+  s.seed = uint64_t(o.integer("seed", 0, int64_t(1) << 53, int64_t(s.seed)));
+  const std::vector<std::string> known = {"pathtrace"};
+  if (std::find(known.begin(), known.end(), s.type) == known.end())
+    o.fail("type", fmt::format("unknown integrator '{}' (known: {})", s.type, fmt::join(known, ", ")));
+  o.finish();
+  return s;
+}
+
+}  // namespace
+
+Scene parse_scene(const nlohmann::json& doc, const std::string& name, const std::filesystem::path& base_dir) {
+  JsonObject root(doc, name, "");
+  Scene scene;
+  scene.camera = parse_camera(root.object("camera"));
+  for (JsonObject& m : root.array_of_objects("media", true)) scene.media.push_back(parse_medium(m, base_dir));
+  for (JsonObject& l : root.array_of_objects("lights", true)) scene.lights.push_back(parse_light(l));
+  if (root.has("integrator")) scene.integrator = parse_integrator(root.object("integrator"));
+  root.finish();
+  scene.source = doc;
+  return scene;
+}
+
+Scene load_scene(const std::filesystem::path& file) {
+  const std::string name = file.string();
+  std::error_code ec;
+  if (!std::filesystem::exists(file, ec)) throw Error(fmt::format("{}: no such file", name));
+  if (std::filesystem::is_directory(file, ec)) throw Error(fmt::format("{}: is a directory", name));
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw Error(fmt::format("{}: cannot be opened for reading", name));
+  std::ostringstream text;
+  text << in.rdbuf();
+  nlohmann::json doc;
+  try {
+    doc = nlohmann::json::parse(text.str());
+  } catch (const nlohmann::json::parse_error& e) {
+    throw Error(fmt::format("{}: not valid JSON: {}", name, e.what()));
+  }
+  Scene scene = parse_scene(doc, name, file.parent_path());
+  scene.file = file;
+  return scene;
+}
+
+}  // namespace nimbus

@@ -1,0 +1,77 @@
+#include "media/majorant.h"
+
+#include <tbb/parallel_for.h>
+
+#include "io/vdb.h"
+
+namespace nimbus {
+
+namespace {
+
+// Smallest voxel edge (world units) of the grid media, 0 when there are none.
+double finest_voxel(const SceneMedia& media) {
+  double best = 0.0;
+  for (int i = 0; i < media.count(); ++i) {
+    const Shape& s = media.medium(i).shape;
+    const DensityGrid* g = nullptr;
+    double scale = 1.0;
+    if (const auto* v = std::get_if<VdbShape>(&s)) {
+      g = v->data.get();
+      scale = v->scale;
+    } else if (const auto* c = std::get_if<CloudShape>(&s)) {
+      g = c->data.get();
+    }
+    if (!g) continue;
+    const double voxel = length(g->index_to_world(Vec3(1, 0, 0)) - g->index_to_world(Vec3(0, 0, 0))) * scale;
+    if (voxel > 0.0 && (best == 0.0 || voxel < best)) best = voxel;
+  }
+  return best;
+}
+
+}  // namespace
+
+MajorantGrid::MajorantGrid(const SceneMedia& media, int resolution, bool global) {
+  bounds_ = media.bounds();
+  if (bounds_.empty()) {
+    maj_.assign(1, 0.0f);
+    return;
+  }
+  // Pad so that points on the boundary fall inside.
+  const Vec3 pad = (bounds_.hi - bounds_.lo) * 1e-6 + Vec3(1e-9);
+  bounds_.lo -= pad;
+  bounds_.hi += pad;
+  const Vec3 extent = bounds_.hi - bounds_.lo;
+  const double longest = std::max({extent.x, extent.y, extent.z});
+  if (global) {
+    res_ = {1, 1, 1};
+  } else {
+    double cell = longest / 32.0;
+    if (resolution > 0) {
+      cell = longest / resolution;
+    } else if (const double voxel = finest_voxel(media); voxel > 0.0) {
+      cell = std::max(4.0 * voxel, longest / 128.0);
+    }
+    for (int a = 0; a < 3; ++a) res_[a] = std::clamp(int(std::ceil(extent[a] / cell)), 1, 256);
+  }
+  for (int a = 0; a < 3; ++a) cell_size_[a] = extent[a] / res_[a];
+  maj_.assign(size_t(res_[0]) * res_[1] * res_[2], 0.0f);
+  tbb::parallel_for(0, res_[2], [&](int z) {
+    for (int y = 0; y < res_[1]; ++y) {
+      for (int x = 0; x < res_[0]; ++x) {
+        Bounds cell;
+        cell.lo = bounds_.lo + Vec3(x, y, z) * cell_size_;
+        cell.hi = cell.lo + cell_size_;
+        double m = 0.0;
+        for (int i = 0; i < media.count(); ++i) {
+          const Medium& med = media.medium(i);
+          const double d = media.max_density(i, cell);
+          if (d > 0.0) m += d * max_component(med.sigma_s + med.sigma_a);
+        }
+        // Round up so the float never falls below the double bound.
+        maj_[(size_t(z) * res_[1] + y) * res_[0] + x] = m > 0.0 ? std::nextafter(float(m), INFINITY) : 0.0f;
+      }
+    }
+  });
+}
+
+}  // namespace nimbus

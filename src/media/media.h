@@ -1,0 +1,48 @@
+// The scene's media prepared for rendering: densities, coefficients at a point, conservative
+// maxima over boxes (for the majorant grid). Overlapping media add their coefficients.
+#pragma once
+
+#include <array>
+#include <vector>
+
+#include "core/math.h"
+#include "nimbus/scene.h"
+
+namespace nimbus {
+
+inline constexpr int kMaxMedia = 16;
+
+// Coefficients at one point: per-medium scattering (to pick the phase function) and totals.
+struct MediumPoint {
+  int count = 0;
+  std::array<Rgb, kMaxMedia> sigma_s_i{};  // scattering of each medium at the point
+  Rgb sigma_s{0.0}, sigma_a{0.0};          // totals
+  Rgb sigma_t() const { return sigma_s + sigma_a; }
+};
+
+class SceneMedia {
+ public:
+  explicit SceneMedia(const std::vector<Medium>& media);
+
+  int count() const { return int(media_.size()); }
+  const Medium& medium(int i) const { return media_[i]; }
+  const Phase& phase(int i) const { return media_[i].phase; }
+  // World-space bounds of the union of all media (empty when there are none).
+  const Bounds& bounds() const { return bounds_; }
+  const Bounds& bounds(int i) const { return medium_bounds_[i]; }
+
+  // Shape density of medium i at world point p (1 inside analytic shapes, the grid value for grids).
+  double density(int i, const Vec3& p) const;
+  // A value >= density(i, p) for every p in the world box.
+  double max_density(int i, const Bounds& box) const;
+  void eval(const Vec3& p, MediumPoint* out) const;
+  // Total extinction per channel at p.
+  Rgb sigma_t(const Vec3& p) const;
+
+ private:
+  std::vector<Medium> media_;
+  std::vector<Bounds> medium_bounds_;
+  Bounds bounds_;
+};
+
+}  // namespace nimbus
