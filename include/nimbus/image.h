@@ -1,5 +1,6 @@
 // TEMPORARY STUB (replaced by the img branch).
 #pragma once
+#include <filesystem>
 #include <string>
 #include <utility>
 #include <vector>
@@ -14,3 +15,6 @@ struct Image {
 };
 using ImageMetadata = std::vector<std::pair<std::string, std::string>>;
 }  // namespace nimbus
+namespace nimbus {
+void write_image(const std::filesystem::path& path, const Image& img, const ImageMetadata& meta, double exposure_stops);
+}

@@ -180,7 +180,7 @@ Scene load_scene(const std::filesystem::path& file) {
   nlohmann::json doc;
   try {
     doc = nlohmann::json::parse(text.str());
-  } catch (const nlohmann::json::parse_error& e) {
+  } catch (const nlohmann::json::exception& e) {
     throw Error(fmt::format("{}: not valid JSON: {}", name, e.what()));
   }
   Scene scene = parse_scene(doc, name, file.parent_path());

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include "nimbus/error.h"
+#include "nimbus/image.h"
 
 namespace nimbus {
 
@@ -14,3 +15,8 @@ void load_vdb_shape(VdbShape& v, const std::filesystem::path& base_dir, const st
 void build_cloud_shape(CloudShape& c) { throw Error("cloud shapes are not supported yet"); }
 
 }  // namespace nimbus
+// TEMPORARY until the vdb/img branches land.
+namespace nimbus {
+Scene builtin_demo_scene() { throw Error("demo not available yet"); }
+void write_image(const std::filesystem::path&, const Image&, const ImageMetadata&, double) { throw Error("no image output yet"); }
+}
