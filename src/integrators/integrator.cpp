@@ -3,7 +3,9 @@
 #include <fmt/format.h>
 
 #include "integrators/pathtrace.h"
+#include "integrators/single.h"
 #include "nimbus/error.h"
+#include "nimbus/render.h"
 
 namespace nimbus {
 
@@ -21,10 +23,19 @@ SceneContext::SceneContext(const Scene& scene, int majorant_resolution, bool glo
   }
 }
 
+void validate_integrator_options(const std::string& type, const nlohmann::json& options, const std::string& where) {
+  if (type == "single") {
+    parse_single_settings(options, where, true);
+  } else if (!options.empty()) {
+    throw Error(fmt::format("{}: /integrator/{}: unknown field for integrator '{}'", where, options.begin().key(), type));
+  }
+}
+
 std::unique_ptr<Integrator> make_integrator(const std::string& type, const IntegratorSettings& settings,
                                             const SceneContext& context) {
   if (type == "pathtrace") return std::make_unique<PathTracer>(context, settings.max_events);
-  throw Error(fmt::format("unknown integrator '{}' (known: pathtrace)", type));
+  if (type == "single") return std::make_unique<SingleScatter>(context, parse_single_settings(settings.options, "scene", false));
+  throw Error(fmt::format("unknown integrator '{}' (known: {})", type, fmt::join(integrator_names(), ", ")));
 }
 
 }  // namespace nimbus

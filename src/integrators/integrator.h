@@ -32,6 +32,9 @@ class Integrator {
   virtual Rgb sample(double px, double py, Rng& rng) const = 0;
 };
 
+// Checks the integrator-specific fields of a scene's integrator block (errors name `where`).
+void validate_integrator_options(const std::string& type, const nlohmann::json& options, const std::string& where);
+
 std::unique_ptr<Integrator> make_integrator(const std::string& type, const IntegratorSettings& settings,
                                             const SceneContext& context);
 

@@ -6,7 +6,9 @@
 #include <fmt/format.h>
 
 #include "io/json_reader.h"
+#include "integrators/integrator.h"
 #include "io/scene_volumes.h"
+#include "nimbus/render.h"
 #include "nimbus/error.h"
 #include "nimbus/scene.h"
 
@@ -141,16 +143,21 @@ Camera parse_camera(JsonObject o) {
   return c;
 }
 
-IntegratorSettings parse_integrator(JsonObject o) {
+IntegratorSettings parse_integrator(const nlohmann::json& j, JsonObject o) {
   IntegratorSettings s;
   s.type = o.string("type", s.type);
   s.spp = int(o.integer("spp", 1, kMaxSpp, s.spp));
   s.max_events = int(o.integer("max_events", 0, 1000000, s.max_events));
   s.seed = uint64_t(o.integer("seed", 0, int64_t(1) << 53, int64_t(s.seed)));
-  const std::vector<std::string> known = {"pathtrace"};
+  const std::vector<std::string> known = integrator_names();
   if (std::find(known.begin(), known.end(), s.type) == known.end())
     o.fail("type", fmt::format("unknown integrator '{}' (known: {})", s.type, fmt::join(known, ", ")));
-  o.finish();
+  // The remaining fields belong to the integrator, which checks them.
+  for (auto it = j.begin(); it != j.end(); ++it) {
+    if (it.key() != "type" && it.key() != "spp" && it.key() != "max_events" && it.key() != "seed")
+      s.options[it.key()] = it.value();
+  }
+  validate_integrator_options(s.type, s.options, o.where());
   return s;
 }
 
@@ -162,7 +169,7 @@ Scene parse_scene(const nlohmann::json& doc, const std::string& name, const std:
   scene.camera = parse_camera(root.object("camera"));
   for (JsonObject& m : root.array_of_objects("media", true)) scene.media.push_back(parse_medium(m, base_dir));
   for (JsonObject& l : root.array_of_objects("lights", true)) scene.lights.push_back(parse_light(l));
-  if (root.has("integrator")) scene.integrator = parse_integrator(root.object("integrator"));
+  if (root.has("integrator")) scene.integrator = parse_integrator(doc["integrator"], root.object("integrator"));
   root.finish();
   scene.source = doc;
   return scene;

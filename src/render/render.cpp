@@ -15,7 +15,7 @@
 
 namespace nimbus {
 
-std::vector<std::string> integrator_names() { return {"pathtrace"}; }
+std::vector<std::string> integrator_names() { return {"pathtrace", "single"}; }
 
 RenderResult render(const Scene& scene, const RenderOptions& options) {
   const auto start = std::chrono::steady_clock::now();

@@ -1,0 +1,72 @@
+#include "integrators/single.h"
+
+#include "integrators/tracking.h"
+#include "io/json_reader.h"
+#include "render/lights.h"
+
+namespace nimbus {
+
+SingleSettings parse_single_settings(const nlohmann::json& options, const std::string& where, bool strict) {
+  SingleSettings s;
+  JsonObject o(options, where, "/integrator");
+  s.tau_step = o.number("tau_step", 1e-4, 100.0, s.tau_step);
+  s.light_samples = int(o.integer("light_samples", 1, 1024, s.light_samples));
+  if (strict) o.finish();
+  return s;
+}
+
+Rgb SingleScatter::sample(double px, double py, Rng& rng) const {
+  return radiance(ctx_.camera.origin(), ctx_.camera.direction(px, py), rng);
+}
+
+Rgb SingleScatter::radiance(const Vec3& o, const Vec3& d, Rng& rng) const {
+  Rgb L(0.0), T(1.0);
+  const double jitter = rng.uniform();
+  MediumPoint mp;
+  ctx_.majorants.traverse(o, d, 0.0, std::numeric_limits<double>::infinity(),
+                          [&](double t0, double t1, double maj) {
+    if (maj <= 0.0) return true;
+    const int n = std::max(1, int(std::ceil((t1 - t0) * maj / s_.tau_step)));
+    const double dt = (t1 - t0) / n;
+    for (int k = 0; k < n; ++k) {
+      const Vec3 p = o + d * (t0 + (k + jitter) * dt);
+      ctx_.media.eval(p, &mp);
+      const Rgb step_T = exp(-mp.sigma_t() * dt);
+      if (max_component(mp.sigma_s) > 0.0) {
+        // Camera-side transmittance to the sample point, then single scattering towards the lights.
+        const Rgb T_here = T * exp(-mp.sigma_t() * (jitter * dt));
+        Rgb in_scatter(0.0);
+        for (int i = 0; i < mp.count; ++i) {
+          if (max_component(mp.sigma_s_i[i]) <= 0.0) continue;
+          const Phase& phase = ctx_.media.phase(i);
+          Rgb Li(0.0);
+          for (int s = 0; s < s_.light_samples; ++s) {
+            for (const Light& light : ctx_.lights) {
+              LightSample ls;
+              const double u1 = rng.uniform(), u2 = rng.uniform();
+              if (!sample_light(light, p, u1, u2, &ls)) continue;
+              const double f = phase_eval(phase, dot(d, ls.wi));
+              if (f <= 0.0) continue;
+              Li += ls.weight * f *
+                    ratio_tracking_transmittance(ctx_.media, ctx_.majorants, p, ls.wi, ls.distance, rng);
+            }
+            if (ctx_.has_environment) {
+              const double u1 = rng.uniform(), u2 = rng.uniform();
+              const Vec3 wi = phase_sample(phase, d, u1, u2);
+              Li += ctx_.environment * ratio_tracking_transmittance(ctx_.media, ctx_.majorants, p, wi,
+                                                                    std::numeric_limits<double>::infinity(), rng);
+            }
+          }
+          in_scatter += mp.sigma_s_i[i] * Li / double(s_.light_samples);
+        }
+        L += T_here * in_scatter * dt;
+      }
+      T *= step_T;
+    }
+    return max_component(T) > 1e-6;
+  });
+  if (ctx_.has_environment) L += T * ctx_.environment;
+  return L;
+}
+
+}  // namespace nimbus
