@@ -11,8 +11,25 @@ SingleSettings parse_single_settings(const nlohmann::json& options, const std::s
   JsonObject o(options, where, "/integrator");
   s.tau_step = o.number("tau_step", 1e-4, 100.0, s.tau_step);
   s.light_samples = int(o.integer("light_samples", 1, 1024, s.light_samples));
+  const std::string transmittance = o.string("transmittance", "ratio");
+  if (transmittance != "ratio" && transmittance != "shadow_map")
+    o.fail("transmittance", "must be \"ratio\" or \"shadow_map\"");
+  s.shadow_map = transmittance == "shadow_map";
+  s.shadow_map_resolution = int(o.integer("shadow_map_resolution", 8, 1024, s.shadow_map_resolution));
   if (strict) o.finish();
   return s;
+}
+
+SingleScatter::SingleScatter(const SceneContext& context, SingleSettings settings) : ctx_(context), s_(settings) {
+  if (s_.shadow_map) {
+    for (const Light& l : ctx_.lights)
+      shadow_maps_.emplace_back(ctx_.media, ctx_.majorants, l, s_.shadow_map_resolution, 0.05);
+  }
+}
+
+Rgb SingleScatter::light_transmittance(size_t l, const Vec3& p, const LightSample& ls, Rng& rng) const {
+  if (!shadow_maps_.empty()) return shadow_maps_[l].lookup(p);
+  return ratio_tracking_transmittance(ctx_.media, ctx_.majorants, p, ls.wi, ls.distance, rng);
 }
 
 Rgb SingleScatter::sample(double px, double py, Rng& rng) const {
@@ -41,14 +58,13 @@ Rgb SingleScatter::radiance(const Vec3& o, const Vec3& d, Rng& rng) const {
           const Phase& phase = ctx_.media.phase(i);
           Rgb Li(0.0);
           for (int s = 0; s < s_.light_samples; ++s) {
-            for (const Light& light : ctx_.lights) {
+            for (size_t l = 0; l < ctx_.lights.size(); ++l) {
               LightSample ls;
               const double u1 = rng.uniform(), u2 = rng.uniform();
-              if (!sample_light(light, p, u1, u2, &ls)) continue;
+              if (!sample_light(ctx_.lights[l], p, u1, u2, &ls)) continue;
               const double f = phase_eval(phase, dot(d, ls.wi));
               if (f <= 0.0) continue;
-              Li += ls.weight * f *
-                    ratio_tracking_transmittance(ctx_.media, ctx_.majorants, p, ls.wi, ls.distance, rng);
+              Li += ls.weight * f * light_transmittance(l, p, ls, rng);
             }
             if (ctx_.has_environment) {
               const double u1 = rng.uniform(), u2 = rng.uniform();

@@ -1,0 +1,73 @@
+#include "integrators/shadow_map.h"
+
+#include <tbb/parallel_for.h>
+
+#include "render/lights.h"
+
+namespace nimbus {
+
+Rgb marched_transmittance(const SceneMedia& media, const MajorantGrid& grid, const Vec3& p, const Vec3& w,
+                          double tmax, double tau_step) {
+  Rgb tau(0.0);
+  grid.traverse(p, w, 0.0, tmax, [&](double t0, double t1, double maj) {
+    if (maj <= 0.0) return true;
+    const int n = std::max(1, int(std::ceil((t1 - t0) * maj / tau_step)));
+    const double dt = (t1 - t0) / n;
+    for (int k = 0; k < n; ++k) tau += media.sigma_t(p + w * (t0 + (k + 0.5) * dt)) * dt;
+    return min_component(tau) < 50.0;
+  });
+  return exp(-tau);
+}
+
+TransmittanceGrid::TransmittanceGrid(const SceneMedia& media, const MajorantGrid& grid, const Light& light,
+                                     int resolution, double tau_step) {
+  bounds_ = grid.bounds();
+  if (bounds_.empty()) {
+    bounds_.lo = Vec3(0.0);
+    bounds_.hi = Vec3(1.0);
+  }
+  const Vec3 extent = bounds_.hi - bounds_.lo;
+  const double longest = std::max({extent.x, extent.y, extent.z});
+  for (int a = 0; a < 3; ++a) {
+    nodes_[a] = std::max(2, int(std::ceil(extent[a] / longest * (resolution - 1))) + 1);
+    spacing_[a] = extent[a] / (nodes_[a] - 1);
+  }
+  values_.assign(size_t(nodes_[0]) * nodes_[1] * nodes_[2] * 3, 1.0f);
+  tbb::parallel_for(0, nodes_[2], [&](int z) {
+    for (int y = 0; y < nodes_[1]; ++y) {
+      for (int x = 0; x < nodes_[0]; ++x) {
+        const Vec3 p = bounds_.lo + Vec3(x, y, z) * spacing_;
+        LightSample ls;
+        Rgb T(1.0);
+        // The centre of the light (a sun disc is treated as its centre direction here).
+        if (const auto* d = std::get_if<DirectionalLight>(&light)) {
+          T = marched_transmittance(media, grid, p, -d->direction, std::numeric_limits<double>::infinity(), tau_step);
+        } else if (sample_light(light, p, 0.5, 0.5, &ls)) {
+          T = marched_transmittance(media, grid, p, ls.wi, ls.distance, tau_step);
+        }
+        float* v = &values_[((size_t(z) * nodes_[1] + y) * nodes_[0] + x) * 3];
+        for (int c = 0; c < 3; ++c) v[c] = float(T[c]);
+      }
+    }
+  });
+}
+
+Rgb TransmittanceGrid::lookup(const Vec3& p) const {
+  int i[3];
+  double f[3];
+  for (int a = 0; a < 3; ++a) {
+    const double u = std::clamp((p[a] - bounds_.lo[a]) / spacing_[a], 0.0, double(nodes_[a] - 1));
+    i[a] = std::min(int(u), nodes_[a] - 2);
+    f[a] = u - i[a];
+  }
+  Rgb r(0.0);
+  for (int k = 0; k < 8; ++k) {
+    const int dx = k & 1, dy = (k >> 1) & 1, dz = (k >> 2) & 1;
+    const double w = (dx ? f[0] : 1 - f[0]) * (dy ? f[1] : 1 - f[1]) * (dz ? f[2] : 1 - f[2]);
+    const float* v = &values_[((size_t(i[2] + dz) * nodes_[1] + i[1] + dy) * nodes_[0] + i[0] + dx) * 3];
+    r += Rgb(v[0], v[1], v[2]) * w;
+  }
+  return r;
+}
+
+}  // namespace nimbus
