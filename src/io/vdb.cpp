@@ -10,6 +10,7 @@
 #include <zlib.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstring>
 #include <fstream>
 #include <limits>
@@ -381,10 +382,12 @@ NanoHandle open_nvdb_grid(const fs::path& file, const std::string& grid_name) {
 // ---- DensityGrid ----------------------------------------------------------------------------------
 
 DensityGrid DensityGrid::load(const std::filesystem::path& file, const std::string& grid_name) {
+  const auto t0 = std::chrono::steady_clock::now();
   const FileKind kind = detect_kind(file);
   auto data = std::make_shared<Data>();
   data->handle = kind == FileKind::OpenVDB ? detail::load_openvdb_float_grid(file, grid_name)
                                            : open_nvdb_grid(file, grid_name);
+  const auto t1 = std::chrono::steady_clock::now();
   const Walk w = check_and_walk(file, data->handle);
   const auto* grid = data->handle.grid<float>();
   if (grid == nullptr) fail(file, "not a float grid");
@@ -468,6 +471,8 @@ DensityGrid DensityGrid::load(const std::filesystem::path& file, const std::stri
   st.max_value = w.max;
   st.mean_active = w.sum / static_cast<double>(w.active_voxels);
   st.negative_count = negative;
+  st.read_seconds = std::chrono::duration<double>(t1 - t0).count();
+  st.analyse_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
   g.max_density_ = *std::max_element(data->bricks.begin(), data->bricks.end());
   g.bricks_ = data->bricks.data();
   g.data_ = std::move(data);
