@@ -48,11 +48,13 @@ class LayoutCheck {
     if (grids > (b_.size() - pos_) / 36) bad(fmt::format("grid count {} exceeds the file", grids));
     std::vector<uint64_t> grid_pos;
     for (uint32_t i = 0; i < grids; ++i) {
-      str("grid name"), str("grid type"), str("instance parent");
+      str("grid name"), str("grid type");
+      if (version >= 216) str("instance parent");
       const uint64_t gp = u64(), block = u64(), end = u64();
       if (gp > b_.size() || block > b_.size() || end > b_.size() || gp > block || block > end)
         bad(fmt::format("grid {} lies outside the file ({} bytes)", i, b_.size()));
       grid_pos.push_back(gp);
+      pos_ = end;  // the next descriptor follows this grid's data
     }
     for (const uint64_t gp : grid_pos) {
       pos_ = gp;
