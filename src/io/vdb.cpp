@@ -384,15 +384,28 @@ NanoHandle open_nvdb_grid(const fs::path& file, const std::string& grid_name) {
 DensityGrid DensityGrid::load(const std::filesystem::path& file, const std::string& grid_name) {
   const auto t0 = std::chrono::steady_clock::now();
   const FileKind kind = detect_kind(file);
-  auto data = std::make_shared<Data>();
-  data->handle = kind == FileKind::OpenVDB ? detail::load_openvdb_float_grid(file, grid_name)
-                                           : open_nvdb_grid(file, grid_name);
-  const auto t1 = std::chrono::steady_clock::now();
-  const Walk w = check_and_walk(file, data->handle);
-  const auto* grid = data->handle.grid<float>();
+  NanoHandle handle = kind == FileKind::OpenVDB ? detail::load_openvdb_float_grid(file, grid_name)
+                                                : open_nvdb_grid(file, grid_name);
+  const auto* grid = handle.grid<float>();
   if (grid == nullptr) fail(file, "not a float grid");
   if (kind == FileKind::NanoVDB && !nanovdb::validateChecksum(*grid, nanovdb::ChecksumMode::Full))
     fail(file, "corrupt grid data: checksum mismatch");
+  const double read_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return analyse(file, std::move(handle), read_seconds);
+}
+
+DensityGrid DensityGrid::from_nanovdb(nanovdb::GridHandle<nanovdb::HostBuffer> handle, const std::string& source) {
+  if (handle.grid<float>() == nullptr) fail(source, "not a float grid");
+  return analyse(source, std::move(handle), 0.0);
+}
+
+DensityGrid DensityGrid::analyse(const std::filesystem::path& file, nanovdb::GridHandle<nanovdb::HostBuffer> handle,
+                                 double read_seconds) {
+  const auto t1 = std::chrono::steady_clock::now();
+  auto data = std::make_shared<Data>();
+  data->handle = std::move(handle);
+  const Walk w = check_and_walk(file, data->handle);
+  const auto* grid = data->handle.grid<float>();
   check_bbox(file, w);
 
   DensityGrid g;
@@ -471,7 +484,7 @@ DensityGrid DensityGrid::load(const std::filesystem::path& file, const std::stri
   st.max_value = w.max;
   st.mean_active = w.sum / static_cast<double>(w.active_voxels);
   st.negative_count = negative;
-  st.read_seconds = std::chrono::duration<double>(t1 - t0).count();
+  st.read_seconds = read_seconds;
   st.analyse_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
   g.max_density_ = *std::max_element(data->bricks.begin(), data->bricks.end());
   g.bricks_ = data->bricks.data();

@@ -12,6 +12,8 @@
 #pragma once
 
 #include <nanovdb/NanoVDB.h>
+#include <nanovdb/util/GridHandle.h>
+#include <nanovdb/util/HostBuffer.h>
 
 #include <array>
 #include <cmath>
@@ -55,6 +57,8 @@ class DensityGrid {
 
   // Loads `file`. grid_name empty = the first float grid of the file. See the top of this header.
   static DensityGrid load(const std::filesystem::path& file, const std::string& grid_name = "");
+  // Wraps a float grid built in memory (e.g. a voxelised procedural shape); `source` names it in errors.
+  static DensityGrid from_nanovdb(nanovdb::GridHandle<nanovdb::HostBuffer> handle, const std::string& source);
 
   // Index space <-> the grid's world space (the file's own transform).
   Vec3 world_to_index(const Vec3& grid_world) const;
@@ -95,6 +99,9 @@ class DensityGrid {
   struct Data;  // owns the NanoVDB buffer, the brick array and the stats (shared by copies)
 
  private:
+  // Checks values, builds the brick max and the statistics of a loaded grid.
+  static DensityGrid analyse(const std::filesystem::path& file, nanovdb::GridHandle<nanovdb::HostBuffer> handle,
+                             double read_seconds);
   template <typename Acc>
   double trilinear(Acc& acc, const Vec3& p) const;
 
