@@ -7,7 +7,6 @@
 #include "io/vdb.h"
 #include "media/cloud.h"
 #include "nimbus/error.h"
-#include "nimbus/image.h"
 
 namespace nimbus {
 
@@ -64,9 +63,5 @@ Scene builtin_demo_scene() {
   return parse_scene(doc, "(built-in demo)", ".");
 }
 
-// TEMPORARY until the img branch lands.
-void write_image(const std::filesystem::path&, const Image&, const ImageMetadata&, double) {
-  throw Error("no image output yet");
-}
 
 }  // namespace nimbus
