@@ -244,7 +244,9 @@ PhotonMcResult run_photon_mc(const PhotonMcSettings& s) {
       var += fb * fb * (xb - mean) * (xb - mean);
     }
     var *= double(B) / double(B - 1);
-    return Estimate{mean * scale, std::sqrt(var) * scale};
+    double err = std::sqrt(var);
+    if (err <= 1e-12 * std::abs(mean)) err = 0.0;  // a deterministic tally (the specular part)
+    return Estimate{mean * scale, err * scale};
   };
   auto solid_angle = [&](size_t i) { return 2.0 * kPi * (std::cos(s.theta_edges[i]) - std::cos(s.theta_edges[i + 1])); };
   auto area = [&](size_t i) { return kPi * (s.r_edges[i + 1] * s.r_edges[i + 1] - s.r_edges[i] * s.r_edges[i]); };

@@ -12,6 +12,8 @@ namespace nimbus {
 
 namespace {
 
+constexpr double kZStep = 0.25;  // spacing in q of the Z table
+
 // Four-point Gauss-Legendre on [-1, 1].
 constexpr double kGl4x[4] = {-0.8611363115940526, -0.3399810435848563, 0.3399810435848563, 0.8611363115940526};
 constexpr double kGl4w[4] = {0.3478548451374538, 0.6521451548625461, 0.6521451548625461, 0.3478548451374538};
@@ -110,23 +112,31 @@ double phase_theta2(const Phase& phase) {
 
 // --- ForwardPropagator ---------------------------------------------------------------------------
 ForwardPropagator::ForwardPropagator(const Phase& phase) : chi_(phase_legendre_moments(phase)) {
-  // Z(q) from Hilb's asymptotics P_l(cos theta) ~ J_0((l + 1/2) theta): Z(l + 1/2) = chi_l, linear in
-  // between, Z = 1 on [0, 1/2], 0 beyond the last moment.  Cumulative integral at integer q.
-  const size_t L = chi_.size();
-  auto Z = [&](double q) {
-    if (q <= 0.5) return 1.0;
-    const double l = q - 0.5;
-    const size_t i = size_t(l);
-    if (i + 1 >= L) return i < L ? chi_[i] * (1.0 - (l - double(i))) : 0.0;
-    return chi_[i] + (l - double(i)) * (chi_[i + 1] - chi_[i]);
+  // Z(q) from Hilb's asymptotics P_l(cos theta) ~ J_0((l + 1/2) theta): Z(l + 1/2) = chi_l, by Catmull-Rom
+  // interpolation in l (Z even in q: chi_{-1} = chi_0, chi_{-2} = chi_1), 0 beyond the last
+  // moment.  Tabulated every kZStep in q, linear in between; on [0, 1] Z = 1 - d q^2 (d = 1 - Z(1)) so
+  // that Z is even and smooth at q = 0 and the spatial profile has a finite variance.
+  const long L = long(chi_.size());
+  auto chi = [&](long l) {
+    const long m = l < 0 ? -1 - l : l;
+    return m < L ? chi_[size_t(m)] : 0.0;
   };
-  auto c = std::make_shared<std::vector<double>>(L + 2, 0.0);
-  for (size_t i = 1; i < c->size(); ++i) {
-    // Z is piecewise linear with breaks at half-integers: integrate [i-1, i-1/2] and [i-1/2, i] exactly.
-    const double a = double(i) - 1.0, m = a + 0.5, b = double(i);
-    (*c)[i] = (*c)[i - 1] + 0.25 * (Z(a) + Z(m)) + 0.25 * (Z(m) + Z(b));
+  auto Z = [&](double q) {
+    const double l = q - 0.5;
+    const long i = long(std::floor(l));
+    const double u = l - double(i);
+    const double c0 = chi(i - 1), c1 = chi(i), c2 = chi(i + 1), c3 = chi(i + 2);
+    return c1 + 0.5 * u * (c2 - c0 + u * (2.0 * c0 - 5.0 * c1 + 4.0 * c2 - c3 + u * (3.0 * (c1 - c2) + c3 - c0)));
+  };
+  const size_t nq = size_t((L + 4) / kZStep) + 1;
+  auto t = std::make_shared<std::vector<double>>(2 * nq, 0.0);
+  const double d = 1.0 - Z(1.0);
+  for (size_t j = 0; j < nq; ++j) {
+    const double q = double(j) * kZStep;
+    (*t)[2 * j] = q < 1.0 ? 1.0 - d * q * q : Z(q);
+    (*t)[2 * j + 1] = q <= 1.0 ? q - d * q * q * q / 3.0 : (*t)[2 * j - 1] + 0.5 * kZStep * ((*t)[2 * j - 2] + (*t)[2 * j]);
   }
-  cumulative_z_ = c;
+  cumulative_z_ = t;
 }
 
 ForwardProfile ForwardPropagator::profile(double tau_s, double tau_a) const {
@@ -176,49 +186,81 @@ double ForwardProfile::angular_within(double theta) const {
   return sum;
 }
 
-double ForwardProfile::spectrum(double k) const {
-  // Zbar(k) = C(k z) / (k z) in mean free paths (z = tau_s); C piecewise quadratic, linear interpolation
-  // of the cumulative integral at integer q is accurate to the Z table's own resolution.
-  const auto& c = *cumulative_z_;
+double ForwardProfile::zbar_and_z(double k, double* z_at) const {
+  // Zbar(k) = C(Q) / Q with Q = k z (mean free paths, z = tau_s), C(Q) = int_0^Q Z; the table holds
+  // (Z, C) every kZStep in Q with Z linear in between, so C is quadratic there and R(k) is C^1.
+  const auto& t = *cumulative_z_;
+  const size_t nq = t.size() / 2;
   const double Q = k * tau_s_;
-  double zbar = 1.0;
-  if (Q > 1e-12) {
-    const double qi = std::floor(Q);
-    double C;
-    if (qi + 1 >= double(c.size())) C = c.back();
-    else {
-      const size_t i = size_t(qi);
-      C = c[i] + (Q - qi) * (c[i + 1] - c[i]);
-    }
-    zbar = C / Q;
+  if (!(Q > 1e-12)) {
+    *z_at = 1.0;
+    return 1.0;
   }
+  if (Q < 1.0) {
+    const double d = 1.0 - t[2 * size_t(1.0 / kZStep)];
+    *z_at = 1.0 - d * Q * Q;
+    return 1.0 - d * Q * Q / 3.0;
+  }
+  const double qi = std::floor(Q / kZStep);
+  if (qi + 1 >= double(nq)) {
+    *z_at = 0.0;
+    return t[2 * (nq - 1) + 1] / Q;
+  }
+  const size_t i = size_t(qi);
+  const double u = Q / kZStep - qi, z0 = t[2 * i], z1 = t[2 * i + 2];
+  *z_at = z0 + u * (z1 - z0);
+  return (t[2 * i + 1] + kZStep * (u * z0 + 0.5 * u * u * (z1 - z0))) / Q;
+}
+
+double ForwardProfile::spectrum(double k) const {
+  double z_at = 0.0;
+  const double zbar = zbar_and_z(k, &z_at);
   return std::exp(-tau_a_ - tau_s_) * std::expm1(tau_s_ * zbar);
+}
+
+double ForwardProfile::spectrum_slope(double k) const {
+  // d/dk exp(-c z) expm1(tau_s Zbar) = exp(-c z) exp(tau_s Zbar) tau_s (Z(kz) - Zbar(k)) / k
+  double z_at = 0.0;
+  const double zbar = zbar_and_z(k, &z_at);
+  if (!(k > 0.0)) return 0.0;
+  return std::exp(-tau_a_ - tau_s_ + tau_s_ * zbar) * tau_s_ * (z_at - zbar) / k;
 }
 
 double ForwardProfile::radial_within(double r) const {
   if (!(r > 0.0) || !(total_ > 0.0)) return 0.0;
-  // P(r) = int_0^inf R(k) r J1(k r) dk = int_0^inf R(x / r) J1(x) dx: Simpson on a log grid in x up to 1,
-  // a uniform grid up to X, and the tail R ~ A / k = A r / x with int_X^inf J1(x)/x dx ~ J0(X)/X - J1(X)/X^2.
-  auto f = [&](double x) { return spectrum(x / r) * std::cyl_bessel_j(1.0, x); };
+  // P(r) = int_0^inf R(k) r J1(k r) dk = int_0^inf R(x / r) J1(x) dx.  Simpson on a log grid below x = 1
+  // and a uniform one (step 0.1) up to X = 200.  Two tails:
+  //  - when k = X / r is beyond the tabulated Z, R(k) ~ A / k exactly (A = exp(-c z) C(inf)), and
+  //    int_X^inf (A r / x) J1(x) dx ~ A r [J0(X)/X + J1(X)/X^2];
+  //  - otherwise (large r) integrate by parts instead: P = R(0) + int_0^inf J0(x) R'(x / r) / r dx, whose
+  //    tail -J1(X) R'(X/r) / r is small, and which has no cancellation problem when P ~ total.
+  const double X = 200.0;
+  const size_t nq = cumulative_z_->size() / 2;
+  const bool asymptotic = X / r * tau_s_ > double(nq) * kZStep && spectrum(X / r) < 1e-3 * total_;
+  auto f = [&](double x) {
+    return asymptotic ? spectrum(x / r) * std::cyl_bessel_j(1.0, x) : std::cyl_bessel_j(0.0, x) * spectrum_slope(x / r) / r;
+  };
   double sum = 0.0;
   {
-    const int n = 240;
-    const double u0 = std::log(1e-7), h = -u0 / n;  // x = e^u, u in [ln 1e-7, 0]
+    const int n = 160;
+    const double u0 = std::log(1e-8), h = -u0 / n;  // x = e^u, u in [ln 1e-8, 0]
     for (int i = 0; i <= n; ++i) {
       const double x = std::exp(u0 + i * h);
       sum += (i == 0 || i == n ? 1.0 : (i % 2 ? 4.0 : 2.0)) * f(x) * x * h / 3.0;
     }
   }
-  const double X = 600.0;
   {
-    const int n = 12000;
+    const int n = 2000;
     const double h = (X - 1.0) / n;
-    for (int i = 0; i <= n; ++i)
-      sum += (i == 0 || i == n ? 1.0 : (i % 2 ? 4.0 : 2.0)) * f(1.0 + i * h) * h / 3.0;
+    for (int i = 0; i <= n; ++i) sum += (i == 0 || i == n ? 1.0 : (i % 2 ? 4.0 : 2.0)) * f(1.0 + i * h) * h / 3.0;
   }
-  const double A = spectrum(X / r) * X / r;  // R(k) k at the cut
-  sum += A * r * (std::cyl_bessel_j(0.0, X) / X - std::cyl_bessel_j(1.0, X) / (X * X));
-  return sum;
+  if (asymptotic) {
+    const double A = spectrum(X / r) * X / r;
+    sum += A * r * (std::cyl_bessel_j(0.0, X) / X + std::cyl_bessel_j(1.0, X) / (X * X));
+  } else {
+    sum = total_ + sum - std::cyl_bessel_j(1.0, X) * spectrum_slope(X / r) / r;
+  }
+  return std::clamp(sum, 0.0, total_);
 }
 
 double ForwardProfile::radial(double r) const {

@@ -59,7 +59,9 @@ class ForwardProfile {
   std::vector<double> f_;  // f_l
   std::shared_ptr<const std::vector<double>> cumulative_z_;  // int_0^(i) Z(q) dq at integer q
   double tau_s_ = 0.0, tau_a_ = 0.0, total_ = 0.0, forward_flux_ = 0.0;
-  double spectrum(double k) const;  // R(k)
+  double spectrum(double k) const;        // R(k)
+  double spectrum_slope(double k) const;  // dR/dk
+  double zbar_and_z(double k, double* z_at) const;
 };
 
 // Built once per phase function (a few ms to ~0.5 s for a sharp tabulated Mie peak), then cheap.
