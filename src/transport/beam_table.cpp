@@ -53,8 +53,9 @@ std::vector<BeamRow> beam_table(const BeamSettings& in, const std::vector<std::s
   for (const std::vector<double>* e : {&s.theta_edges, &s.r_edges})
     if (e->size() < 2) throw Error("bin edges need at least two values");
   for (const auto& m : models)
-    if (std::find(beam_model_names().begin(), beam_model_names().end(), m) == beam_model_names().end())
-      throw Error(fmt::format("unknown model '{}' (known: mc, dolin, tes87, mfs, gsa)", m));
+    if (m != "mc_fwd" && std::find(beam_model_names().begin(), beam_model_names().end(), m) == beam_model_names().end())
+      throw Error(fmt::format("unknown model '{}' (known: mc, dolin, tes87, mfs, gsa; diagnostic: mc_fwd)", m));
+  const bool want_fwd = std::find(models.begin(), models.end(), "mc_fwd") != models.end();
 
   const double a = (1.0 - s.albedo) / s.albedo;  // absorption per scattering length
   const bool slab = std::isfinite(s.thickness);
@@ -82,8 +83,10 @@ std::vector<BeamRow> beam_table(const BeamSettings& in, const std::vector<std::s
     rows.push_back({name, z, "unscattered", 0.0, 0.0, entry * std::exp(-(1.0 + a) * z), 0.0});
   };
 
-  for (const std::string& m : beam_model_names()) {
-    if (std::find(models.begin(), models.end(), m) == models.end()) continue;
+  std::vector<std::string> order = beam_model_names();
+  for (const std::string& m : order) {
+    const bool asked = std::find(models.begin(), models.end(), m) != models.end();
+    if (!asked && !(m == "mc" && want_fwd)) continue;
     if (m == "mc") {
       PhotonMcSettings mc;
       mc.sigma_s = 1.0;
@@ -99,6 +102,11 @@ std::vector<BeamRow> beam_table(const BeamSettings& in, const std::vector<std::s
       mc.batches = s.batches;
       const PhotonMcResult r = run_photon_mc(mc);
       for (const PlaneTally& t : r.planes) {
+        if (want_fwd)
+          for (size_t i = 0; i < t.angular.size(); ++i)
+            rows.push_back({"mc_fwd", t.depth, "angular", te[i], te[i + 1], t.angular_forward_only[i].value,
+                            t.angular_forward_only[i].err});
+        if (!asked) continue;
         for (size_t i = 0; i < t.angular.size(); ++i)
           rows.push_back({"mc", t.depth, "angular", te[i], te[i + 1], t.angular[i].value, t.angular[i].err});
         for (size_t i = 0; i < t.radial.size(); ++i)

@@ -40,7 +40,8 @@ std::vector<double> default_r_edges();
 // All known model names, in output order.
 const std::vector<std::string>& beam_model_names();
 
-// Rows for the requested models (each must be one of beam_model_names()).  Models other than `mc`
+// Rows for the requested models (each must be one of beam_model_names(), or the diagnostic `mc_fwd`:
+// the Monte Carlo's angular tally restricted to photons that never travelled backward).  Models other than `mc`
 // describe an infinite medium; in a slab they are scaled by the entry transmission 1 - Rsp.
 // Throws nimbus::Error on invalid settings.
 std::vector<BeamRow> beam_table(const BeamSettings& settings, const std::vector<std::string>& models);

@@ -58,7 +58,7 @@ TabulatedPhase load_phase_table(const std::string& name, const std::string& path
     char comma = 0;
     std::istringstream ls(line);
     if (!(ls >> t >> comma >> v) || comma != ',') {
-      if (theta.empty() && row <= 2) continue;  // header
+      if (theta.empty()) continue;  // a header line before the data
       throw Error(fmt::format("{}:{}: expected 'theta,value'", path, row));
     }
     theta.push_back(t);

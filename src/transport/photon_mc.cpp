@@ -40,10 +40,11 @@ constexpr double kRouletteSurvival = 0.1;    // MCML
 // Offsets of every tally in one flat accumulator per batch.
 struct Layout {
   size_t P, NA, NR;
-  size_t plane_stride() const { return NA + NR + 1; }
+  size_t plane_stride() const { return 2 * NA + NR + 1; }
   size_t angular(size_t k) const { return k * plane_stride(); }
   size_t radial(size_t k) const { return k * plane_stride() + NA; }
   size_t unscattered(size_t k) const { return k * plane_stride() + NA + NR; }
+  size_t angular_forward_only(size_t k) const { return k * plane_stride() + NA + NR + 1; }
   size_t totals() const { return P * plane_stride(); }  // specular, Rd, Tt, Tu, absorbed
   size_t reflect_angular() const { return totals() + 5; }
   size_t reflect_radial() const { return reflect_angular() + NA; }
@@ -103,7 +104,7 @@ class Tracer {
       w = 1.0 - rsp;
     }
     Vec3 p(0.0, 0.0, 0.0), d(0.0, 0.0, 1.0);
-    bool scattered = false;
+    bool scattered = false, turned = false;
     int zone_seen = 0;
     const double inf = std::numeric_limits<double>::infinity();
     while (true) {
@@ -119,7 +120,7 @@ class Tracer {
       if (!std::isfinite(step)) return;  // moving parallel to the faces of an empty slab
       Vec3 p1 = p + d * step;
       if (hits) p1.z = d.z > 0.0 ? s_.thickness : 0.0;
-      tally_planes(p, p1, d, w, scattered, acc);
+      tally_planes(p, p1, d, w, scattered, turned, acc);
       p = p1;
 
       if (hits) {
@@ -130,6 +131,7 @@ class Tracer {
         if (wt > 0.0) tally_exit(d.z > 0.0, std::acos(std::clamp(cos_t, 0.0, 1.0)), p, wt, scattered, acc);
         w *= R;
         d.z = -d.z;
+        turned = turned || d.z <= 0.0;
         if (!(w > 0.0)) return;
       } else {
         // Interaction: deposit the absorbed fraction, scatter the rest.
@@ -139,6 +141,7 @@ class Tracer {
         const double u1 = rng.uniform(), u2 = rng.uniform();
         d = normalize(phase_sample(s_.phase, d, u1, u2));
         scattered = true;
+        turned = turned || d.z <= 0.0;
       }
 
       // Russian roulette on weight (MCML): survive with probability 0.1 at weight / 0.1.
@@ -160,7 +163,8 @@ class Tracer {
 
  private:
   // Crossings of the tally planes by the segment p0 -> p1 (direction d).
-  void tally_planes(const Vec3& p0, const Vec3& p1, const Vec3& d, double w, bool scattered, double* acc) const {
+  void tally_planes(const Vec3& p0, const Vec3& p1, const Vec3& d, double w, bool scattered, bool turned,
+                    double* acc) const {
     const auto& zs = s_.plane_depths;
     if (zs.empty() || d.z == 0.0) return;
     size_t k0, k1;  // planes [k0, k1) are crossed
@@ -177,7 +181,10 @@ class Tracer {
         continue;
       }
       const int ia = bin_of(s_.theta_edges, std::acos(std::clamp(d.z, -1.0, 1.0)));
-      if (ia >= 0) acc[L_.angular(k) + ia] += w / std::abs(d.z);
+      if (ia >= 0) {
+        acc[L_.angular(k) + ia] += w / std::abs(d.z);
+        if (!turned) acc[L_.angular_forward_only(k) + ia] += w / std::abs(d.z);
+      }
       if (d.z > 0.0) {
         const double t = (zs[k] - p0.z) / d.z;
         const int ir = bin_of(s_.r_edges, std::hypot(p0.x + d.x * t, p0.y + d.y * t));
@@ -255,7 +262,10 @@ PhotonMcResult run_photon_mc(const PhotonMcSettings& s) {
   for (size_t k = 0; k < L.P; ++k) {
     PlaneTally t;
     t.depth = s.plane_depths[k];
-    for (size_t i = 0; i < NA; ++i) t.angular.push_back(estimate(L.angular(k) + i, 1.0 / solid_angle(i)));
+    for (size_t i = 0; i < NA; ++i) {
+      t.angular.push_back(estimate(L.angular(k) + i, 1.0 / solid_angle(i)));
+      t.angular_forward_only.push_back(estimate(L.angular_forward_only(k) + i, 1.0 / solid_angle(i)));
+    }
     for (size_t i = 0; i < NR; ++i) t.radial.push_back(estimate(L.radial(k) + i, 1.0 / area(i)));
     t.unscattered = estimate(L.unscattered(k), 1.0);
     r.planes.push_back(std::move(t));

@@ -19,6 +19,7 @@
 //    angular bins of the polar angle theta of propagation, as weight / |cos theta| / bin solid angle
 //    (plane-integrated radiance per sr), and forward crossings (cos theta > 0) to radial bins as weight
 //    / annulus area (forward flux per unit area); unscattered crossings go to `unscattered` only;
+//    the angular tally is also kept for photons that never travelled backward (diagnostic);
 //  - slab: diffuse reflectance (everything leaving the top face, i.e. all but the specular part, also
 //    unscattered light reflected at the bottom face), transmittance (everything leaving the bottom face,
 //    unscattered included) and unscattered transmittance apart, absorbed weight; exits also resolved in
@@ -58,6 +59,9 @@ struct PlaneTally {
   double depth = 0.0;
   std::vector<Estimate> angular;  // per sr, plane-integrated scattered radiance (bins of theta_edges)
   std::vector<Estimate> radial;   // per unit area, forward scattered flux (bins of r_edges)
+  // Diagnostic: the part of `angular` carried by photons that never travelled backward (cos theta <= 0)
+  // before the crossing, the light a small-angle model describes.
+  std::vector<Estimate> angular_forward_only;
   Estimate unscattered;           // unscattered flux through the plane
 };
 
