@@ -83,7 +83,7 @@ double procedural_cloud_density(const Vec3& p, uint32_t seed) {
   const double billow = fbm(p * 3.5, seed, 5);
   field += 0.45 * billow * (0.6 + 0.4 * std::clamp(p.z + 0.5, 0.0, 1.0)) - 0.05;
   const double base = std::clamp((p.z + 0.32) / 0.08, 0.0, 1.0);
-  const double d = std::clamp(field * 3.0, 0.0, 1.0) * base;
+  const double d = std::clamp(field * 6.0, 0.0, 1.0) * base;
   // Keep everything inside the unit ball so the voxelised bounds hold the whole cloud.
   return length(p) < 0.98 ? d : 0.0;
 }

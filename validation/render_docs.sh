@@ -1,0 +1,12 @@
+#!/usr/bin/env bash
+# Regenerates the pictures in docs/images/ (run from the repository root after `make`).
+set -euo pipefail
+NIMBUS=${NIMBUS:-build/bin/nimbus}
+SPP=${SPP:-512}
+mkdir -p docs/images out
+"$NIMBUS" render -o out/demo.exr --spp "$SPP" --quiet
+"$NIMBUS" render -o docs/images/demo.png --spp "$SPP" --quiet
+"$NIMBUS" render scenes/disney_cloud.json -o out/disney_cloud.exr --spp "$SPP" --quiet
+"$NIMBUS" render scenes/disney_cloud.json -o docs/images/disney_cloud.png --spp "$SPP" --quiet
+"$NIMBUS" render scenes/sphere_hg.json -o docs/images/sphere_hg.png --spp "$SPP" --quiet
+echo "docs/images regenerated"
