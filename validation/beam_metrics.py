@@ -102,15 +102,18 @@ def metrics(d, model, depth, cone, edges=None):
     return L0, e0, hwhm(bins, L0)
 
 
-def hwhm_stderr(d, depth, cone, samples=200, seed=1):
-    """Bootstrap-like spread of the MC half-width: perturb bins by their standard errors."""
+def hwhm_stderr(d, depth, cone, edges, samples=200, seed=1):
+    """Spread of the MC half-width when the merged bins are perturbed by their standard errors."""
     import random
     rng = random.Random(seed)
-    bins = d[("mc", depth, "angular")]
+    bins = rebin(d[("mc", depth, "angular")], edges)
     vals = []
     for _ in range(samples):
         pert = [(lo, hi, v + rng.gauss(0.0, e), e) for lo, hi, v, e in bins]
         L0, _ = on_axis(pert, cone)
         vals.append(hwhm(pert, L0))
+    vals = [v for v in vals if math.isfinite(v)]
+    if len(vals) < samples // 2:
+        return float("nan")
     m = sum(vals) / len(vals)
     return math.sqrt(sum((x - m) ** 2 for x in vals) / (len(vals) - 1))

@@ -12,7 +12,8 @@ namespace nimbus {
 
 namespace {
 
-constexpr double kZStep = 0.25;  // spacing in q of the Z table
+constexpr double kZStep = 0.25;   // spacing in q of the Z table
+constexpr double kZDirect = 16.0;  // Z by direct Hankel quadrature below this q, by Hilb above
 
 // Four-point Gauss-Legendre on [-1, 1].
 constexpr double kGl4x[4] = {-0.8611363115940526, -0.3399810435848563, 0.3399810435848563, 0.8611363115940526};
@@ -112,29 +113,68 @@ double phase_theta2(const Phase& phase) {
 
 // --- ForwardPropagator ---------------------------------------------------------------------------
 ForwardPropagator::ForwardPropagator(const Phase& phase) : chi_(phase_legendre_moments(phase)) {
-  // Z(q) from Hilb's asymptotics P_l(cos theta) ~ J_0((l + 1/2) theta): Z(l + 1/2) = chi_l, by Catmull-Rom
-  // interpolation in l (Z even in q: chi_{-1} = chi_0, chi_{-2} = chi_1), 0 beyond the last
-  // moment.  Tabulated every kZStep in q, linear in between; on [0, 1] Z = 1 - d q^2 (d = 1 - Z(1)) so
-  // that Z is even and smooth at q = 0 and the spatial profile has a finite variance.
+  // Z(q), the small-angle (2-D) Fourier transform of the phase function:
+  //  - for q <= kZDirect directly, Z(q) = 2 pi int_0^pi P(theta) J0(q theta) sin(theta) dtheta: the
+  //    transform of a non-negative function (so the spatial density stays non-negative), Z(0) = 1, and
+  //    smooth at q = 0 because deflections are bounded by pi;
+  //  - for large q from the moments by Hilb's asymptotics P_l(cos theta) ~ J0((l + 1/2) theta):
+  //    Z(l + 1/2) = chi_l, Catmull-Rom in l, 0 beyond the last moment;
+  //  - blended smoothly on [kZDirect / 2, kZDirect].
   const long L = long(chi_.size());
   auto chi = [&](long l) {
     const long m = l < 0 ? -1 - l : l;
     return m < L ? chi_[size_t(m)] : 0.0;
   };
-  auto Z = [&](double q) {
+  auto z_hilb = [&](double q) {
     const double l = q - 0.5;
     const long i = long(std::floor(l));
     const double u = l - double(i);
     const double c0 = chi(i - 1), c1 = chi(i), c2 = chi(i + 1), c3 = chi(i + 2);
     return c1 + 0.5 * u * (c2 - c0 + u * (2.0 * c0 - 5.0 * c1 + 4.0 * c2 - c3 + u * (3.0 * (c1 - c2) + c3 - c0)));
   };
+  // Quadrature in theta: geometric panels from 1e-6 to pi (and a tabulated phase function's nodes).
+  std::vector<double> edges{0.0};
+  for (double th = 1e-6; th < kPi; th *= 1.02) edges.push_back(th);
+  if (const auto* tp = std::get_if<TabulatedPhase>(&phase)) edges.insert(edges.end(), tp->theta.begin(), tp->theta.end());
+  edges.push_back(kPi);
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  std::vector<double> nodes, weights;
+  for (size_t i = 0; i + 1 < edges.size(); ++i) {
+    const double h = edges[i + 1] - edges[i];
+    for (int q = 0; q < 4; ++q) {
+      const double th = edges[i] + h * (0.5 + 0.5 * kGl4x[q]);
+      nodes.push_back(th);
+      weights.push_back(0.5 * h * kGl4w[q] * 2.0 * kPi * phase_eval(phase, std::cos(th)) * std::sin(th));
+    }
+  }
+  double norm = 0.0;
+  for (double w : weights) norm += w;
+  auto z_direct = [&](double q) {
+    double sum = 0.0;
+    for (size_t i = 0; i < nodes.size(); ++i) sum += weights[i] * std::cyl_bessel_j(0.0, q * nodes[i]);
+    return sum / norm;
+  };
+  auto Z = [&](double q) {
+    if (q <= 0.5 * kZDirect) return z_direct(q);
+    if (q >= kZDirect) return z_hilb(q);
+    const double u = (q - 0.5 * kZDirect) / (0.5 * kZDirect), w = u * u * (3.0 - 2.0 * u);  // smoothstep
+    return (1.0 - w) * z_direct(q) + w * z_hilb(q);
+  };
   const size_t nq = size_t((L + 4) / kZStep) + 1;
-  auto t = std::make_shared<std::vector<double>>(2 * nq, 0.0);
-  const double d = 1.0 - Z(1.0);
+  // Table: per node (Z, Z', C); cubic Hermite in between, C its exact integral, so R(k) is C^1 in k and
+  // its Hankel transform free of ripples.
+  const double eps = 1e-4;
+  auto t = std::make_shared<std::vector<double>>(3 * nq, 0.0);
   for (size_t j = 0; j < nq; ++j) {
     const double q = double(j) * kZStep;
-    (*t)[2 * j] = q < 1.0 ? 1.0 - d * q * q : Z(q);
-    (*t)[2 * j + 1] = q <= 1.0 ? q - d * q * q * q / 3.0 : (*t)[2 * j - 1] + 0.5 * kZStep * ((*t)[2 * j - 2] + (*t)[2 * j]);
+    const double z = Z(q), m = q == 0.0 ? 0.0 : (Z(q + eps) - Z(q - eps)) / (2.0 * eps);
+    (*t)[3 * j] = z;
+    (*t)[3 * j + 1] = m;
+    if (j > 0) {
+      const double z0 = (*t)[3 * j - 3], m0 = (*t)[3 * j - 2];
+      (*t)[3 * j + 2] = (*t)[3 * j - 1] + kZStep * (0.5 * (z0 + z) + kZStep * (m0 - m) / 12.0);
+    }
   }
   cumulative_z_ = t;
 }
@@ -187,29 +227,27 @@ double ForwardProfile::angular_within(double theta) const {
 }
 
 double ForwardProfile::zbar_and_z(double k, double* z_at) const {
-  // Zbar(k) = C(Q) / Q with Q = k z (mean free paths, z = tau_s), C(Q) = int_0^Q Z; the table holds
-  // (Z, C) every kZStep in Q with Z linear in between, so C is quadratic there and R(k) is C^1.
+  // Zbar(k) = C(Q) / Q with Q = k z (mean free paths, z = tau_s), C(Q) = int_0^Q Z, from the Hermite table.
   const auto& t = *cumulative_z_;
-  const size_t nq = t.size() / 2;
+  const size_t nq = t.size() / 3;
   const double Q = k * tau_s_;
   if (!(Q > 1e-12)) {
     *z_at = 1.0;
     return 1.0;
   }
-  if (Q < 1.0) {
-    const double d = 1.0 - t[2 * size_t(1.0 / kZStep)];
-    *z_at = 1.0 - d * Q * Q;
-    return 1.0 - d * Q * Q / 3.0;
-  }
   const double qi = std::floor(Q / kZStep);
   if (qi + 1 >= double(nq)) {
     *z_at = 0.0;
-    return t[2 * (nq - 1) + 1] / Q;
+    return t[3 * (nq - 1) + 2] / Q;
   }
   const size_t i = size_t(qi);
-  const double u = Q / kZStep - qi, z0 = t[2 * i], z1 = t[2 * i + 2];
-  *z_at = z0 + u * (z1 - z0);
-  return (t[2 * i + 1] + kZStep * (u * z0 + 0.5 * u * u * (z1 - z0))) / Q;
+  const double u = Q / kZStep - qi, h = kZStep;
+  const double z0 = t[3 * i], m0 = t[3 * i + 1], c0 = t[3 * i + 2], z1 = t[3 * i + 3], m1 = t[3 * i + 4];
+  const double u2 = u * u, u3 = u2 * u, u4 = u3 * u;
+  *z_at = (2 * u3 - 3 * u2 + 1) * z0 + (u3 - 2 * u2 + u) * h * m0 + (-2 * u3 + 3 * u2) * z1 + (u3 - u2) * h * m1;
+  const double C = c0 + h * ((u - u3 + 0.5 * u4) * z0 + (0.5 * u2 - 2.0 * u3 / 3.0 + 0.25 * u4) * h * m0 +
+                             (u3 - 0.5 * u4) * z1 + (0.25 * u4 - u3 / 3.0) * h * m1);
+  return C / Q;
 }
 
 double ForwardProfile::spectrum(double k) const {
@@ -235,7 +273,7 @@ double ForwardProfile::radial_within(double r) const {
   //  - otherwise (large r) integrate by parts instead: P = R(0) + int_0^inf J0(x) R'(x / r) / r dx, whose
   //    tail -J1(X) R'(X/r) / r is small, and which has no cancellation problem when P ~ total.
   const double X = 200.0;
-  const size_t nq = cumulative_z_->size() / 2;
+  const size_t nq = cumulative_z_->size() / 3;
   const bool asymptotic = X / r * tau_s_ > double(nq) * kZStep && spectrum(X / r) < 1e-3 * total_;
   auto f = [&](double x) {
     return asymptotic ? spectrum(x / r) * std::cyl_bessel_j(1.0, x) : std::cyl_bessel_j(0.0, x) * spectrum_slope(x / r) / r;

@@ -86,5 +86,23 @@ TEST(PhotonMcSlow, VanDeHulstSlabTable) {
   EXPECT_EQ(r.specular.value, 0.0);
 }
 
+// Giovanelli's semi-infinite isotropic medium (albedo 0.9) with a mismatched boundary, n = 1.5: total
+// reflection (specular 0.04 included) 0.2600, as quoted in the MCML checks (Prahl et al. 1989; Wang,
+// Jacques & Zheng 1995).  (With n = 1 the exact value is the H-function's 0.4149, tested above.)
+TEST(PhotonMcSlow, SemiInfiniteMismatchedBoundaryGiovanelli) {
+  PhotonMcSettings s;
+  s.sigma_s = 90.0;
+  s.sigma_a = 10.0;
+  s.phase = IsotropicPhase{};
+  s.thickness = 2.0;  // 200 mean free paths
+  s.n = 1.5;
+  s.photons = 200000;
+  s.batches = 20;
+  const PhotonMcResult r = run_photon_mc(s);
+  EXPECT_NEAR(r.specular.value, 0.04, 1e-12);
+  EXPECT_NEAR(r.specular.value + r.diffuse_reflectance.value, 0.2600, 5.0 * r.diffuse_reflectance.err + 5e-4);
+  EXPECT_NEAR(r.specular.value + r.diffuse_reflectance.value + r.transmittance.value + r.absorbed.value, 1.0, 1e-4);
+}
+
 }  // namespace
 }  // namespace nimbus
