@@ -15,11 +15,22 @@
 //  - SPACE.  The transverse spread uses the small-angle solution of the transfer equation for the
 //    actual Fourier-transformed phase function Z(q) (seed eq. 4 with Z not expanded):
 //        R(k) = exp(-tau_a - tau_s) [exp(tau_s Zbar(k)) - 1],  Zbar(k) = (1/z) int_0^z Z(k u) du,
-//    whose inverse 2-D Fourier (Hankel) transform is the density per unit area.  Z(q) is taken from the
-//    same moments through Hilb's asymptotics, Z(l + 1/2) ~ chi_l.  Radii are in scattering mean free
-//    paths of the path (r_mfp = r tau_s / z for a path of physical length z).  As in every small-angle
-//    solution all scattered light is carried forward: radial_within(infinity) = total(), not the smaller
-//    forward_flux() (the light near the axis, which dominates the profile, is forward light).
+//    whose inverse 2-D Fourier (Hankel) transform is the density per unit area (the n-scatter random walk
+//    with Poisson(tau_s) scatters at uniform positions, summed).  Z(q) = 2 pi int P J0(q theta) sin theta
+//    dtheta by quadrature for small q, and chi_l = Z(l + 1/2) (Hilb's asymptotics) for large q.  Radii are
+//    in scattering mean free paths of the path (r_mfp = r tau_s / z for a path of physical length z, and a
+//    density per mfp^2 times (tau_s / z)^2 is per physical area).  As in every small-angle solution all
+//    scattered light is carried forward: radial_within(infinity) = total(), not forward_flux().
+//  - LIMITS (docs/validation/beam.md): within a few % of photon Monte Carlo in on-axis radiance and
+//    half-width where forward light dominates; it has no diffuse (returning) light, and it neglects the
+//    extra absorption on lengthened paths (matters once z sqrt(a b theta2) ~ 1, see mfs_kernel.h).
+//
+// Use from a renderer (heterogeneous media: accumulate tau_s, tau_a along the path):
+//     const ForwardPropagator prop(phase);              // once per phase function
+//     const ForwardProfile p = prop.profile(tau_s, tau_a);
+//     p.angular(theta)       // scattered radiance per sr at angle theta from the path's direction
+//     p.radial(r_mfp)        // scattered power per mfp^2 at transverse distance r_mfp
+//     p.total()              // all scattered, unabsorbed power
 // Integrals of the radial profile are done by numerical Hankel transforms with an analytic tail.
 #pragma once
 
