@@ -55,10 +55,10 @@ Scene builtin_demo_scene() {
          {"phase", {{"type", "hg"}, {"g", 0.85}}}}}},
       {"lights",
        {{{"type", "directional"},
-         {"direction", {-0.55, 0.45, -0.7}},
-         {"irradiance", {2.6, 2.45, 2.2}},
+         {"direction", {-0.75, -0.3, -0.55}},
+         {"irradiance", {3.4, 3.2, 2.9}},
          {"angular_diameter_deg", 0.53}},
-        {{"type", "environment"}, {"radiance", {0.10, 0.16, 0.30}}}}},
+        {{"type", "environment"}, {"radiance", {0.07, 0.12, 0.25}}}}},
       {"integrator", {{"type", "pathtrace"}, {"spp", 64}, {"seed", 1}}}};
   return parse_scene(doc, "(built-in demo)", ".");
 }
