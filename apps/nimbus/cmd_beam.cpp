@@ -34,24 +34,6 @@ struct BeamArgs {
   bool n_given = false;
 };
 
-std::vector<double> parse_list(const std::string& what, const std::string& list) {
-  std::vector<double> v;
-  std::stringstream ss(list);
-  std::string item;
-  while (std::getline(ss, item, ',')) {
-    size_t used = 0;
-    double x = 0.0;
-    try {
-      x = std::stod(item, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used == 0 || used != item.size() || !std::isfinite(x)) throw Error(fmt::format("{}: '{}' is not a number", what, item));
-    v.push_back(x);
-  }
-  if (v.empty()) throw Error(fmt::format("{}: empty list", what));
-  return v;
-}
 
 std::vector<std::string> split_names(const std::string& list) {
   std::vector<std::string> v;
@@ -88,11 +70,11 @@ int run_beam(const BeamArgs& a) {
   s.phase = parse_phase_spec(a.phase);
   s.albedo = a.albedo;
   if (!(a.albedo > 0.0 && a.albedo <= 1.0)) throw Error(fmt::format("--albedo must lie in (0, 1] (got {})", a.albedo));
-  s.depths = parse_list("--depths", a.depths);
+  s.depths = parse_number_list("--depths", a.depths);
   if (a.geometry == "infinite") {
     if (a.n_given && a.n != 1.0) throw Error("--n needs --geometry slab:D");
   } else if (a.geometry.rfind("slab:", 0) == 0) {
-    s.thickness = parse_list("--geometry slab:D", a.geometry.substr(5)).at(0);
+    s.thickness = parse_number_list("--geometry slab:D", a.geometry.substr(5)).at(0);
     if (!(s.thickness > 0.0)) throw Error("--geometry slab:D needs D > 0");
   } else {
     throw Error(fmt::format("--geometry '{}': use infinite or slab:D", a.geometry));
@@ -103,8 +85,8 @@ int run_beam(const BeamArgs& a) {
     throw Error("--photons must be a whole number >= 20");
   s.photons = uint64_t(a.photons);
   s.seed = a.seed;
-  if (!a.theta_edges.empty()) s.theta_edges = parse_list("--theta-edges", a.theta_edges);
-  if (!a.r_edges.empty()) s.r_edges = parse_list("--r-edges", a.r_edges);
+  if (!a.theta_edges.empty()) s.theta_edges = parse_number_list("--theta-edges", a.theta_edges);
+  if (!a.r_edges.empty()) s.r_edges = parse_number_list("--r-edges", a.r_edges);
   const std::vector<std::string> models = a.models.empty() ? beam_model_names() : split_names(a.models);
   if (models.empty()) throw Error("--models: empty list");
 

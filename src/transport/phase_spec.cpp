@@ -15,6 +15,18 @@ namespace nimbus {
 namespace {
 
 std::vector<double> parse_numbers(const std::string& spec, const std::string& list, size_t count) {
+  const std::vector<double> v = parse_number_list(fmt::format("phase '{}'", spec), list);
+  if (v.size() != count) throw Error(fmt::format("phase '{}': expected {} number(s), got {}", spec, count, v.size()));
+  return v;
+}
+
+void check_g(const std::string& spec, double g) {
+  if (!(g > -1.0 && g < 1.0)) throw Error(fmt::format("phase '{}': asymmetry g must lie in (-1, 1)", spec));
+}
+
+}  // namespace
+
+std::vector<double> parse_number_list(const std::string& what, const std::string& list) {
   std::vector<double> v;
   std::stringstream ss(list);
   std::string item;
@@ -27,18 +39,12 @@ std::vector<double> parse_numbers(const std::string& spec, const std::string& li
       used = 0;
     }
     if (used == 0 || used != item.size() || !std::isfinite(x))
-      throw Error(fmt::format("phase '{}': '{}' is not a number", spec, item));
+      throw Error(fmt::format("{}: '{}' is not a number", what, item));
     v.push_back(x);
   }
-  if (v.size() != count) throw Error(fmt::format("phase '{}': expected {} number(s), got {}", spec, count, v.size()));
+  if (v.empty()) throw Error(fmt::format("{}: empty list", what));
   return v;
 }
-
-void check_g(const std::string& spec, double g) {
-  if (!(g > -1.0 && g < 1.0)) throw Error(fmt::format("phase '{}': asymmetry g must lie in (-1, 1)", spec));
-}
-
-}  // namespace
 
 std::string phase_table_dir() {
   if (const char* d = std::getenv("NIMBUS_DATA_DIR"); d && *d) return std::string(d) + "/phase";

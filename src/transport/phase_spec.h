@@ -3,10 +3,14 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "media/phase.h"
 
 namespace nimbus {
+
+// Comma-separated finite numbers ("1,3,10"); errors start with `what` and quote the bad item.
+std::vector<double> parse_number_list(const std::string& what, const std::string& list);
 
 // Throws nimbus::Error naming the spec on anything malformed or out of range.
 Phase parse_phase_spec(const std::string& spec);
