@@ -24,8 +24,7 @@ build: configure
 demo: deps
 	@$(MAKE) --no-print-directory build
 	@mkdir -p out
-	$(BUILD)/bin/nimbus render -o out/demo.exr
-	$(BUILD)/bin/nimbus render -o out/demo.png --quiet
+	$(BUILD)/bin/nimbus render -o out/demo.exr --preview out/demo.png
 	@echo "nimbus: demo written to out/demo.exr and out/demo.png"
 
 test: deps

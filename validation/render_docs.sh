@@ -4,9 +4,7 @@ set -euo pipefail
 NIMBUS=${NIMBUS:-build/bin/nimbus}
 SPP=${SPP:-512}
 mkdir -p docs/images out
-"$NIMBUS" render -o out/demo.exr --spp "$SPP" --quiet
-"$NIMBUS" render -o docs/images/demo.png --spp "$SPP" --quiet
-"$NIMBUS" render scenes/disney_cloud.json -o out/disney_cloud.exr --spp "$SPP" --quiet
-"$NIMBUS" render scenes/disney_cloud.json -o docs/images/disney_cloud.png --spp "$SPP" --quiet
-"$NIMBUS" render scenes/sphere_hg.json -o docs/images/sphere_hg.png --spp "$SPP" --quiet
+"$NIMBUS" render -o out/demo.exr --preview docs/images/demo.png --spp "$SPP" --quiet
+"$NIMBUS" render scenes/disney_cloud.json -o out/disney_cloud.exr --preview docs/images/disney_cloud.png --spp "$SPP" --quiet
+"$NIMBUS" render scenes/sphere_hg.json -o out/sphere_hg.exr --preview docs/images/sphere_hg.png --spp "$SPP" --quiet
 echo "docs/images regenerated"

@@ -27,6 +27,7 @@ extern "C" void on_signal(int sig) {
 struct RenderArgs {
   std::string scene;
   std::string output;
+  std::string preview;  // optional PNG written beside the main output
   std::optional<int> spp;
   std::optional<uint64_t> seed;
   std::optional<std::string> integrator;
@@ -54,6 +55,8 @@ int run_render(const RenderArgs& args) {
   const std::string ext = lower_extension(out);
   if (ext != ".exr" && ext != ".png")
     throw Error(fmt::format("{}: unsupported output format '{}' (use .exr or .png)", args.output, ext));
+  if (!args.preview.empty() && lower_extension(args.preview) != ".png")
+    throw Error(fmt::format("{}: the preview must be a .png file", args.preview));
   const std::filesystem::path dir = out.has_parent_path() ? out.parent_path() : std::filesystem::path(".");
   std::error_code ec;
   if (!std::filesystem::is_directory(dir, ec))
@@ -83,12 +86,14 @@ int run_render(const RenderArgs& args) {
   if (result.partial) {
     const auto target = partial_name(out);
     write_image(target, result.image, result.metadata, args.exposure);
+    if (!args.preview.empty()) write_image(partial_name(args.preview), result.image, {}, args.exposure);
     fmt::print(stderr, "nimbus: interrupted ({}): partial image ({} of {} tiles) written to {}\n",
                g_signal.load() == SIGTERM ? "SIGTERM" : "SIGINT", result.tiles_done, result.tiles_total,
                target.string());
     return kExitFailure;
   }
   write_image(out, result.image, result.metadata, args.exposure);
+  if (!args.preview.empty()) write_image(args.preview, result.image, {}, args.exposure);
   if (!args.quiet) {
     fmt::print(stderr, "nimbus: {} {}x{} {} spp in {:.2f}s -> {}\n", result.integrator, result.image.width,
                result.image.height, result.spp, result.seconds, out.string());
@@ -104,6 +109,7 @@ void add_render_command(CLI::App& app, Action& action) {
   cmd->add_option("scene", args->scene, "Scene JSON file (omit for the built-in demo)");
   cmd->add_option("-o,--output", args->output, "Output image: .exr (linear float RGB) or .png (sRGB preview)")
       ->required();
+  cmd->add_option("--preview", args->preview, "Also write an sRGB PNG preview of the same render");
   cmd->add_option("--spp", args->spp, "Samples per pixel (overrides the scene)")->check(CLI::Range(1, kMaxSpp));
   cmd->add_option("--threads", args->threads, "Worker threads (0 = all cores)")->check(CLI::Range(0, 4096));
   cmd->add_option("--seed", args->seed, "Random seed (overrides the scene)");

@@ -59,7 +59,7 @@ Scene builtin_demo_scene() {
          {"irradiance", {3.4, 3.2, 2.9}},
          {"angular_diameter_deg", 0.53}},
         {{"type", "environment"}, {"radiance", {0.07, 0.12, 0.25}}}}},
-      {"integrator", {{"type", "pathtrace"}, {"spp", 64}, {"seed", 1}}}};
+      {"integrator", {{"type", "pathtrace"}, {"spp", 256}, {"seed", 1}}}};
   return parse_scene(doc, "(built-in demo)", ".");
 }
 
