@@ -50,6 +50,12 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
     const int x0 = int(tile % tiles_x) * ts, y0 = int(tile / tiles_x) * ts;
     int64_t bad = 0;
     for (int y = y0; y < std::min(y0 + ts, H); ++y) {
+      // Stay responsive inside long tiles: abandon the tile (it counts as not done).
+      if (options.cancel && options.cancel->load(std::memory_order_relaxed)) {
+        stopped = true;
+        nonfinite += bad;
+        return;
+      }
       for (int x = x0; x < std::min(x0 + ts, W); ++x) {
         Rgb sum(0.0);
         for (int s = 0; s < settings.spp; ++s) {

@@ -1,0 +1,114 @@
+// nimbus render end to end: outputs and their headers, failed runs leave existing files alone, and
+// SIGINT writes a flagged partial image under its own name.
+#include <gtest/gtest.h>
+
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <thread>
+
+#include "nimbus/image.h"
+
+namespace nimbus {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path fresh_dir(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / ("nimbus_render_cli_" + name);
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+void write_scene(const fs::path& file, int size, int spp) {
+  std::ofstream(file) << R"({"camera": {"position": [0, -4, 0], "look_at": [0, 0, 0], "up": [0, 0, 1],
+    "fov_y_deg": 30, "width": )" << size << R"(, "height": )" << size << R"(},
+    "media": [{"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1}, "sigma_s": 5.0,
+               "phase": {"type": "hg", "g": 0.7}}],
+    "lights": [{"type": "directional", "direction": [1, 1, -1], "irradiance": 2.0},
+               {"type": "environment", "radiance": 0.1}],
+    "integrator": {"type": "pathtrace", "spp": )" << spp << "}}";
+}
+
+int run(const std::string& args) {
+  const int status = std::system((std::string(NIMBUS_CLI) + " " + args).c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+std::string meta_value(const ImageMetadata& meta, const std::string& key) {
+  for (const auto& [k, v] : meta)
+    if (k == key) return v;
+  return "(missing)";
+}
+
+TEST(RenderCli, WritesExrWithHeaderAndPreview) {
+  const fs::path dir = fresh_dir("ok");
+  write_scene(dir / "s.json", 16, 2);
+  ASSERT_EQ(run("render " + (dir / "s.json").string() + " -o " + (dir / "a.exr").string() + " --preview " +
+                (dir / "a.png").string() + " --quiet --seed 3"),
+            0);
+  ImageMetadata meta;
+  const Image img = read_exr(dir / "a.exr", &meta);
+  EXPECT_EQ(img.width, 16);
+  EXPECT_EQ(meta_value(meta, "nimbus/partial"), "false");
+  EXPECT_EQ(meta_value(meta, "nimbus/seed"), "3");
+  EXPECT_EQ(meta_value(meta, "nimbus/integrator"), "pathtrace");
+  EXPECT_NE(meta_value(meta, "nimbus/scene").find("\"sigma_s\":5.0"), std::string::npos);
+  EXPECT_TRUE(fs::exists(dir / "a.png"));
+}
+
+TEST(RenderCli, FailedRunKeepsTheExistingOutput) {
+  const fs::path dir = fresh_dir("keep");
+  write_scene(dir / "s.json", 8, 1);
+  std::ofstream(dir / "out.exr") << "precious";
+  EXPECT_EQ(run("render " + (dir / "s.json").string() + " -o " + (dir / "out.exr").string() +
+                " --integrator nope --quiet 2>/dev/null"),
+            2);
+  EXPECT_EQ(run("render " + (dir / "s.json").string() + " -o " + (dir / "out.tif").string() + " --quiet 2>/dev/null"),
+            2);
+  EXPECT_EQ(run("render " + (dir / "s.json").string() + " -o " + (dir / "nodir" / "x.exr").string() +
+                " --quiet 2>/dev/null"),
+            2);
+  std::ifstream in(dir / "out.exr");
+  std::string content;
+  in >> content;
+  EXPECT_EQ(content, "precious");
+  int files = 0;
+  for ([[maybe_unused]] const auto& e : fs::directory_iterator(dir)) ++files;
+  EXPECT_EQ(files, 2);  // s.json and out.exr: no temporaries, no new outputs
+}
+
+TEST(RenderCli, SigintWritesAFlaggedPartialImage) {
+  const fs::path dir = fresh_dir("sigint");
+  write_scene(dir / "s.json", 256, 4096);  // minutes of work: it will be interrupted
+  std::ofstream(dir / "out.exr") << "precious";
+  const pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    execl(NIMBUS_CLI, NIMBUS_CLI, "render", (dir / "s.json").c_str(), "-o", (dir / "out.exr").c_str(), "--quiet",
+          "--threads", "1", static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(700));
+  kill(pid, SIGINT);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 1);
+  ImageMetadata meta;
+  const Image partial = read_exr(dir / "out.partial.exr", &meta);
+  EXPECT_EQ(meta_value(meta, "nimbus/partial"), "true");
+  EXPECT_EQ(partial.width, 256);
+  std::ifstream in(dir / "out.exr");
+  std::string content;
+  in >> content;
+  EXPECT_EQ(content, "precious");
+}
+
+}  // namespace
+}  // namespace nimbus
