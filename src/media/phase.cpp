@@ -62,13 +62,19 @@ double tabulated_sample_theta(const TabulatedPhase& p, double u) {
   const double v0 = p.value[i - 1], v1 = p.value[i];
   const double b = (v1 - v0) / (t1 - t0), a = v0 - b * t0;
   const double target = (u - p.cdf[i - 1]) / (2.0 * kPi);
-  // Invert the (monotone) partial integral on [t0, t1] by bisection.
-  double lo = t0, hi = t1;
+  // Invert the (monotone) partial integral on [t0, t1]: Newton steps, kept inside a shrinking
+  // bracket (bisection where Newton would leave it).
+  double lo = t0, hi = t1, t = 0.5 * (t0 + t1);
   for (int k = 0; k < 60; ++k) {
-    const double mid = 0.5 * (lo + hi);
-    (linear_sin_integral(a, b, t0, mid) < target ? lo : hi) = mid;
+    const double f = linear_sin_integral(a, b, t0, t) - target;
+    if (std::abs(f) <= 1e-15 * std::max(1.0, std::abs(target))) break;
+    (f < 0.0 ? lo : hi) = t;
+    const double slope = (a + b * t) * std::sin(t);
+    const double next = slope > 0.0 ? t - f / slope : 0.5 * (lo + hi);
+    t = (next > lo && next < hi) ? next : 0.5 * (lo + hi);
+    if (hi - lo < 1e-14) break;
   }
-  return 0.5 * (lo + hi);
+  return t;
 }
 
 }  // namespace
