@@ -13,8 +13,9 @@ Mapping (docs/validation/cycles.md explains and checks each line):
   media        homogeneous only (sphere, box). Volume Scatter gives sigma_s = Color * Density,
                Volume Absorption gives sigma_a = (1 - Color) * Density (Cycles svm_node_closure_volume),
                so Color = sigma/max(sigma), Density = max(sigma) per closure, added with an Add Shader.
-               Phase: Anisotropy = HG g; double_hg = two Volume Scatter closures with densities
-               w * sigma_s and (1 - w) * sigma_s. Box = cube mesh (exact); sphere = UV sphere whose
+               Phase: Anisotropy = HG g; double_hg would be two Volume Scatter closures with
+               densities w * sigma_s and (1 - w) * sigma_s, but Cycles 3.4 gets their weights
+               wrong (refused unless --allow-multi-lobe). Box = cube mesh (exact); sphere = UV sphere whose
                radius is scaled so that the polyhedron's volume equals the sphere's (deviation reported).
   directional  SUN lamp, Strength = irradiance (W/m^2), Color = irradiance / max, angle = angular
                diameter (use 0: Cycles' disc radiance is S/(pi tan^2(a/2)), nimbus' S/(pi sin^2(a/2))).
@@ -45,7 +46,12 @@ def parse_args():
                    help="UV sphere segments around (rings = segments / 2)")
     p.add_argument("--npy", default=None, help="also save the pixels as (h, w, 3) float32 .npy")
     p.add_argument("--blend", default=None, help="also save the built .blend (debugging)")
+    p.add_argument("--allow-multi-lobe", action="store_true",
+                   help="render double_hg as two Volume Scatter closures although Cycles 3.4 gets it wrong")
     return p.parse_args(argv)
+
+
+ALLOW_MULTI_LOBE = False
 
 
 def rgb(value):
@@ -114,6 +120,12 @@ def volume_material(name, medium):
     elif kind == "double_hg":
         w = float(phase["w"])
         lobes = [(w, float(phase["g1"])), (1.0 - w, float(phase["g2"]))]
+        if 0.0 < w < 1.0 and not ALLOW_MULTI_LOBE:
+            # Measured against single_scatter_reference.py: Cycles 3.4 weighs two added Volume
+            # Scatter closures equally in light sampling (2.000x for w = 0.5 or g1 = g2).
+            raise ValueError(f"{name}: double_hg needs two Volume Scatter closures, which Cycles 3.4 "
+                             "does not weigh correctly (docs/validation/cycles.md); "
+                             "--allow-multi-lobe renders it anyway")
     else:
         raise ValueError(f"{name}: phase '{kind}' has no Cycles equivalent")
     color, scale = color_and_scale(medium["sigma_s"])
@@ -288,7 +300,9 @@ def exr_to_array(path):
 
 
 def main():
+    global ALLOW_MULTI_LOBE
     args = parse_args()
+    ALLOW_MULTI_LOBE = args.allow_multi_lobe
     with open(args.scene) as f:
         scene_json = json.load(f)
     bpy.ops.wm.read_factory_settings(use_empty=True)
