@@ -91,7 +91,9 @@ def stats(n1, n2, c1, c2, k, ref=None):
     s["rel_rmse"] = math.sqrt(np.mean((Nb - Cb) ** 2)) / Cb.mean()
     s["rel_rmse_floor"] = math.sqrt(np.mean(vb)) / Cb.mean()
     s["rmse_ratio"] = s["rel_rmse"] / s["rel_rmse_floor"]
-    s["bin_z"] = (Nb - Cb) / np.sqrt(np.maximum(vb, 1e-30))
+    # Map of the channel sum (channels are correlated: their variances do not simply add).
+    vsum = binned(((n1 - n2).sum(-1, keepdims=True) ** 2 + (c1 - c2).sum(-1, keepdims=True) ** 2) / 4, k) / (k * k)
+    s["bin_z"] = (Nb - Cb).sum(-1) / np.sqrt(np.maximum(vsum[..., 0], 1e-30))
     if ref is not None:
         s["mean_reference"] = ref.mean((0, 1))
         for key, X, v in (("nimbus", N, vN), ("cycles", C, vC)):
@@ -112,16 +114,15 @@ def save_png(path, name, N, C, bin_z):
     tone = lambda x: np.clip(x / scale, 0, 1) ** (1 / 2.2)  # noqa: E731
     fig, ax = plt.subplots(1, 3, figsize=(7.2, 2.6), dpi=80)
     ax[0].imshow(tone(N), interpolation="nearest")
-    ax[0].set_title("nimbus pathtrace", fontsize=9)
+    ax[0].set_title(f"{name}: nimbus", fontsize=9)
     ax[1].imshow(tone(C), interpolation="nearest")
     ax[1].set_title("Cycles 3.4", fontsize=9)
-    im = ax[2].imshow(bin_z.mean(-1) * math.sqrt(3), cmap="RdBu_r", vmin=-4, vmax=4, interpolation="nearest")
-    ax[2].set_title("(nimbus - Cycles) / sigma, 4x4 bins", fontsize=9)
+    im = ax[2].imshow(bin_z, cmap="RdBu_r", vmin=-4, vmax=4, interpolation="nearest")
+    ax[2].set_title("(nimbus - Cycles) / sigma, RGB sum,\n4x4 bins", fontsize=8)
     fig.colorbar(im, ax=ax[2], fraction=0.046, pad=0.04)
     for a in ax:
         a.set_xticks([])
         a.set_yticks([])
-    fig.suptitle(name, fontsize=9)
     fig.tight_layout()
     fig.savefig(path, dpi=80)
     plt.close(fig)
