@@ -1,11 +1,152 @@
-// nimbus beam: not yet implemented (stub registered so the CLI layout is fixed).
+// nimbus beam: a pencil beam into a forward-scattering medium, photon Monte Carlo against every
+// propagator (Dolin, Tessendorf 87/88, the corrected MFS kernel, the generalised small-angle one),
+// tallied at planes of given optical depth.  Lengths in scattering mean free paths (b = 1).
+//
+// CSV columns: model,depth,quantity,lo,hi,value,stderr with quantity
+//   angular     bins of polar angle [rad]; plane-integrated scattered radiance per sr per source photon
+//   radial      bins of radius [mfp]; forward scattered flux per unit area per source photon
+//   unscattered lo = hi = 0; unscattered flux through the plane
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <unistd.h>
+
 #include "commands.h"
+#include "nimbus/error.h"
+#include "transport/beam_table.h"
+#include "transport/phase_spec.h"
 
 namespace nimbus::cli {
 
+namespace {
+
+struct BeamArgs {
+  std::string phase, geometry = "infinite", models, theta_edges, r_edges, out;
+  double albedo = -1.0, n = 1.0, photons = 1e6;
+  std::string depths;
+  uint64_t seed = 1;
+  bool n_given = false;
+};
+
+std::vector<double> parse_list(const std::string& what, const std::string& list) {
+  std::vector<double> v;
+  std::stringstream ss(list);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    size_t used = 0;
+    double x = 0.0;
+    try {
+      x = std::stod(item, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != item.size() || !std::isfinite(x)) throw Error(fmt::format("{}: '{}' is not a number", what, item));
+    v.push_back(x);
+  }
+  if (v.empty()) throw Error(fmt::format("{}: empty list", what));
+  return v;
+}
+
+std::vector<std::string> split_names(const std::string& list) {
+  std::vector<std::string> v;
+  std::stringstream ss(list);
+  std::string item;
+  while (std::getline(ss, item, ','))
+    if (!item.empty()) v.push_back(item);
+  return v;
+}
+
+// Writes `text` to `path` atomically: a temporary file beside it, then rename.
+void write_atomically(const std::string& path, const std::string& text) {
+  const std::string tmp = fmt::format("{}.tmp-{}", path, ::getpid());
+  {
+    std::ofstream out(tmp, std::ios::binary);
+    out << text;
+    out.flush();
+    if (!out) {
+      std::error_code ec;
+      std::filesystem::remove(tmp, ec);
+      throw std::runtime_error(fmt::format("cannot write {}", path));
+    }
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) {
+    std::filesystem::remove(tmp, ec);
+    throw std::runtime_error(fmt::format("cannot write {}", path));
+  }
+}
+
+int run_beam(const BeamArgs& a) {
+  BeamSettings s;
+  s.phase = parse_phase_spec(a.phase);
+  s.albedo = a.albedo;
+  if (!(a.albedo > 0.0 && a.albedo <= 1.0)) throw Error(fmt::format("--albedo must lie in (0, 1] (got {})", a.albedo));
+  s.depths = parse_list("--depths", a.depths);
+  if (a.geometry == "infinite") {
+    if (a.n_given && a.n != 1.0) throw Error("--n needs --geometry slab:D");
+  } else if (a.geometry.rfind("slab:", 0) == 0) {
+    s.thickness = parse_list("--geometry slab:D", a.geometry.substr(5)).at(0);
+    if (!(s.thickness > 0.0)) throw Error("--geometry slab:D needs D > 0");
+  } else {
+    throw Error(fmt::format("--geometry '{}': use infinite or slab:D", a.geometry));
+  }
+  if (!(a.n > 0.0)) throw Error("--n must be > 0");
+  s.n = a.n;
+  if (!(a.photons >= 20.0) || a.photons > 1e12 || a.photons != std::floor(a.photons))
+    throw Error("--photons must be a whole number >= 20");
+  s.photons = uint64_t(a.photons);
+  s.seed = a.seed;
+  if (!a.theta_edges.empty()) s.theta_edges = parse_list("--theta-edges", a.theta_edges);
+  if (!a.r_edges.empty()) s.r_edges = parse_list("--r-edges", a.r_edges);
+  const std::vector<std::string> models = a.models.empty() ? beam_model_names() : split_names(a.models);
+  if (models.empty()) throw Error("--models: empty list");
+
+  const std::vector<BeamRow> rows = beam_table(s, models);
+  std::string text = "model,depth,quantity,lo,hi,value,stderr\n";
+  for (const BeamRow& r : rows)
+    text += fmt::format("{},{:.9g},{},{:.9g},{:.9g},{:.9g},{:.9g}\n", r.model, r.depth, r.quantity, r.lo, r.hi, r.value, r.stderr_);
+  if (a.out.empty() || a.out == "-") {
+    std::fwrite(text.data(), 1, text.size(), stdout);
+  } else {
+    try {
+      write_atomically(a.out, text);
+    } catch (const std::runtime_error& e) {
+      fmt::print(stderr, "nimbus: error: {}\n", e.what());
+      return kExitFailure;
+    }
+  }
+  return kExitOk;
+}
+
+}  // namespace
+
 void add_beam_command(CLI::App& app, Action& action) {
-  auto* cmd = app.add_subcommand("beam", "(not yet implemented)");
-  cmd->callback([&action] { action = [] { throw CLI::RuntimeError("not yet implemented", 1); return 1; }; });
+  auto args = std::make_shared<BeamArgs>();
+  auto* cmd = app.add_subcommand("beam",
+                                 "Pencil beam into a scattering medium: photon Monte Carlo against the small-angle "
+                                 "propagators (lengths in scattering mean free paths)");
+  cmd->add_option("--phase", args->phase, "Phase function: iso, hg:G, dhg:G1,G2,W, gauss:THETA2, mie:NAME")->required();
+  cmd->add_option("--albedo", args->albedo, "Single-scattering albedo b/c in (0, 1]")->required();
+  cmd->add_option("--depths", args->depths, "Optical depths b z of the tally planes, comma-separated")->required();
+  cmd->add_option("--geometry", args->geometry, "infinite (default) or slab:D (D in mean free paths)");
+  auto* n_opt = cmd->add_option("--n", args->n, "Refractive index of the slab against 1 outside (default 1)");
+  cmd->add_option("--photons", args->photons, "Monte Carlo photons (default 1e6)");
+  cmd->add_option("--models", args->models, "Comma-separated subset of mc,dolin,tes87,mfs,gsa (default all)");
+  cmd->add_option("--theta-edges", args->theta_edges, "Polar-angle bin edges [rad], comma-separated");
+  cmd->add_option("--r-edges", args->r_edges, "Radius bin edges [mean free paths], comma-separated");
+  cmd->add_option("--seed", args->seed, "Random seed (default 1)");
+  cmd->add_option("-o,--output", args->out, "Output CSV (default stdout)");
+  cmd->callback([args, n_opt, &action] {
+    args->n_given = n_opt->count() > 0;
+    action = [args] { return run_beam(*args); };
+  });
 }
 
 }  // namespace nimbus::cli

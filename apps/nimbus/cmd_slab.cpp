@@ -1,11 +1,129 @@
-// nimbus slab: not yet implemented (stub registered so the CLI layout is fixed).
+// nimbus slab: photon Monte Carlo of a pencil beam normally incident on a slab, MCML conventions
+// (physical units: any consistent length unit).  Prints `name value stderr` lines for specular,
+// diffuse_reflectance, transmittance (unscattered included), unscattered_transmittance and absorbed;
+// --csv [FILE] adds angle- and radius-resolved reflectance and transmittance (to FILE or stdout):
+//   side,quantity,lo,hi,value,stderr   side = reflect|transmit, quantity = angular (per sr of exit
+//   solid angle, exit polar angle outside the slab, rad) or radial (per unit area, exit radius).
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <unistd.h>
+
 #include "commands.h"
+#include "core/math.h"
+#include "nimbus/error.h"
+#include "transport/photon_mc.h"
 
 namespace nimbus::cli {
 
+namespace {
+
+struct SlabArgs {
+  double mu_s = -1.0, mu_a = -1.0, g = 0.0, thickness = -1.0, n = 1.0, photons = 1e6;
+  uint64_t seed = 1;
+  int angle_bins = 30, r_bins = 50;
+  double r_max = 0.0;
+  bool csv = false;
+  std::string csv_path;
+};
+
+int run_slab(const SlabArgs& a) {
+  if (!(a.mu_s >= 0.0) || !std::isfinite(a.mu_s)) throw Error(fmt::format("--mu-s must be >= 0 (got {})", a.mu_s));
+  if (!(a.mu_a >= 0.0) || !std::isfinite(a.mu_a)) throw Error(fmt::format("--mu-a must be >= 0 (got {})", a.mu_a));
+  if (!(a.g > -1.0 && a.g < 1.0)) throw Error(fmt::format("--g must lie in (-1, 1) (got {})", a.g));
+  if (!(a.thickness > 0.0) || !std::isfinite(a.thickness)) throw Error(fmt::format("--thickness must be > 0 (got {})", a.thickness));
+  if (!(a.n >= 1.0) || !std::isfinite(a.n) || a.n > 10.0) throw Error(fmt::format("--n must lie in [1, 10] (got {})", a.n));
+  if (!(a.photons >= 20.0) || a.photons > 1e12 || a.photons != std::floor(a.photons))
+    throw Error("--photons must be a whole number >= 20");
+  if (a.angle_bins < 1 || a.r_bins < 1) throw Error("--angle-bins and --r-bins must be >= 1");
+  PhotonMcSettings s;
+  s.sigma_s = a.mu_s;
+  s.sigma_a = a.mu_a;
+  s.phase = HgPhase{a.g};
+  s.thickness = a.thickness;
+  s.n = a.n;
+  s.photons = uint64_t(a.photons);
+  s.seed = a.seed;
+  s.batches = 20;
+  for (int i = 0; i <= a.angle_bins; ++i) s.theta_edges.push_back(0.5 * kPi * i / a.angle_bins);
+  const double transport = a.mu_a + a.mu_s * (1.0 - a.g);
+  const double r_max = a.r_max > 0.0 ? a.r_max : 5.0 * std::max(a.thickness, transport > 0.0 ? 1.0 / transport : a.thickness);
+  for (int i = 0; i <= a.r_bins; ++i) s.r_edges.push_back(r_max * i / a.r_bins);
+  const PhotonMcResult r = run_photon_mc(s);
+
+  std::string text;
+  auto line = [&](const char* name, const Estimate& e) { text += fmt::format("{} {:.8g} {:.3g}\n", name, e.value, e.err); };
+  line("specular", r.specular);
+  line("diffuse_reflectance", r.diffuse_reflectance);
+  line("transmittance", r.transmittance);
+  line("unscattered_transmittance", r.unscattered_transmittance);
+  line("absorbed", r.absorbed);
+  std::fwrite(text.data(), 1, text.size(), stdout);
+  if (!a.csv) return kExitOk;
+
+  std::string csv = "side,quantity,lo,hi,value,stderr\n";
+  auto rows = [&](const char* side, const char* q, const std::vector<double>& edges, const std::vector<Estimate>& v) {
+    for (size_t i = 0; i < v.size(); ++i)
+      csv += fmt::format("{},{},{:.9g},{:.9g},{:.9g},{:.9g}\n", side, q, edges[i], edges[i + 1], v[i].value, v[i].err);
+  };
+  rows("reflect", "angular", s.theta_edges, r.reflect_angular);
+  rows("reflect", "radial", s.r_edges, r.reflect_radial);
+  rows("transmit", "angular", s.theta_edges, r.transmit_angular);
+  rows("transmit", "radial", s.r_edges, r.transmit_radial);
+  if (a.csv_path.empty() || a.csv_path == "-") {
+    std::fwrite(csv.data(), 1, csv.size(), stdout);
+    return kExitOk;
+  }
+  const std::string tmp = fmt::format("{}.tmp-{}", a.csv_path, ::getpid());
+  {
+    std::ofstream out(tmp, std::ios::binary);
+    out << csv;
+    out.flush();
+    if (!out) {
+      std::error_code ec;
+      std::filesystem::remove(tmp, ec);
+      fmt::print(stderr, "nimbus: error: cannot write {}\n", a.csv_path);
+      return kExitFailure;
+    }
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, a.csv_path, ec);
+  if (ec) {
+    std::filesystem::remove(tmp, ec);
+    fmt::print(stderr, "nimbus: error: cannot write {}\n", a.csv_path);
+    return kExitFailure;
+  }
+  return kExitOk;
+}
+
+}  // namespace
+
 void add_slab_command(CLI::App& app, Action& action) {
-  auto* cmd = app.add_subcommand("slab", "(not yet implemented)");
-  cmd->callback([&action] { action = [] { throw CLI::RuntimeError("not yet implemented", 1); return 1; }; });
+  auto args = std::make_shared<SlabArgs>();
+  auto* cmd = app.add_subcommand("slab",
+                                 "Photon Monte Carlo of a pencil beam on a slab (MCML conventions, HG phase, "
+                                 "physical units)");
+  cmd->add_option("--mu-s", args->mu_s, "Scattering coefficient [1/length]")->required();
+  cmd->add_option("--mu-a", args->mu_a, "Absorption coefficient [1/length]")->required();
+  cmd->add_option("--g", args->g, "Henyey-Greenstein asymmetry g")->required();
+  cmd->add_option("--thickness", args->thickness, "Slab thickness [length]")->required();
+  cmd->add_option("--n", args->n, "Refractive index of the slab against 1 outside (default 1)");
+  cmd->add_option("--photons", args->photons, "Photons (default 1e6)");
+  cmd->add_option("--seed", args->seed, "Random seed (default 1)");
+  cmd->add_option("--angle-bins", args->angle_bins, "Exit-angle bins over [0, pi/2] for --csv (default 30)");
+  cmd->add_option("--r-bins", args->r_bins, "Exit-radius bins for --csv (default 50)");
+  cmd->add_option("--r-max", args->r_max, "Largest exit radius for --csv (default 5 transport lengths or 5 D)");
+  auto* csv = cmd->add_option("--csv", args->csv_path, "Also write angle- and radius-resolved tallies (to FILE, or stdout)")
+                  ->expected(0, 1);
+  cmd->callback([args, csv, &action] {
+    args->csv = csv->count() > 0;
+    action = [args] { return run_slab(*args); };
+  });
 }
 
 }  // namespace nimbus::cli

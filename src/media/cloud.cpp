@@ -31,9 +31,9 @@ std::array<Blob, 14> make_blobs(uint32_t seed) {
   Rng rng(seed, 0x636c6f7564ull);
   std::array<Blob, 14> blobs;
   for (size_t i = 0; i < blobs.size(); ++i) {
-    const double a = 2.0 * kPi * rng.uniform(), r = 0.55 * std::sqrt(rng.uniform());
-    const double radius = 0.22 + 0.2 * rng.uniform() * (1.0 - r);
-    const double z = -0.25 + radius * 0.6 + 0.35 * (0.55 - r) * rng.uniform();
+    const double a = 2.0 * kPi * rng.uniform(), r = 0.5 * std::sqrt(rng.uniform());
+    const double radius = 0.3 + 0.25 * rng.uniform() * (1.0 - r);
+    const double z = -0.3 + radius * 0.75 + 0.3 * (0.5 - r) * rng.uniform();
     blobs[i] = {Vec3(r * std::cos(a), r * std::sin(a) * 0.7, z), radius};
   }
   return blobs;

@@ -1,0 +1,119 @@
+#include "nimbus/image.h"
+
+#include <png.h>
+
+#include <OpenEXR/ImfChannelList.h>
+#include <OpenEXR/ImfFrameBuffer.h>
+#include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfInputFile.h>
+#include <OpenEXR/ImfOutputFile.h>
+#include <OpenEXR/ImfStringAttribute.h>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "io/atomic_file.h"
+#include "nimbus/error.h"
+
+namespace nimbus {
+
+namespace fs = std::filesystem;
+
+Image::Image(int w, int h) : width(w), height(h) {
+  if (w <= 0 || h <= 0) throw Error(fmt::format("image size {}x{}: must be positive", w, h));
+  if (int64_t(w) * h > (int64_t(1) << 28)) throw Error(fmt::format("image size {}x{}: too large", w, h));
+  rgb.assign(size_t(w) * h * 3, 0.0f);
+}
+
+double srgb_encode(double x) {
+  x = std::clamp(x, 0.0, 1.0);
+  return x <= 0.0031308 ? 12.92 * x : 1.055 * std::pow(x, 1.0 / 2.4) - 0.055;
+}
+
+void write_exr(const fs::path& path, const Image& img, const ImageMetadata& meta) {
+  if (img.width <= 0 || img.height <= 0 || img.rgb.size() != size_t(img.width) * img.height * 3)
+    throw Error(fmt::format("{}: cannot write an empty or malformed image", path.string()));
+  atomic_write(path, [&](const fs::path& tmp) {
+    Imf::Header header(img.width, img.height);
+    header.compression() = Imf::ZIP_COMPRESSION;
+    for (const char* c : {"R", "G", "B"}) header.channels().insert(c, Imf::Channel(Imf::FLOAT));
+    for (const auto& [key, value] : meta) header.insert(key, Imf::StringAttribute(value));
+    Imf::OutputFile file(tmp.c_str(), header);
+    Imf::FrameBuffer fb;
+    char* base = reinterpret_cast<char*>(const_cast<float*>(img.rgb.data()));
+    const size_t xs = 3 * sizeof(float), ys = xs * img.width;
+    fb.insert("R", Imf::Slice(Imf::FLOAT, base, xs, ys));
+    fb.insert("G", Imf::Slice(Imf::FLOAT, base + sizeof(float), xs, ys));
+    fb.insert("B", Imf::Slice(Imf::FLOAT, base + 2 * sizeof(float), xs, ys));
+    file.setFrameBuffer(fb);
+    file.writePixels(img.height);
+  });
+}
+
+Image read_exr(const fs::path& path, ImageMetadata* meta) {
+  std::error_code ec;
+  if (!fs::exists(path, ec)) throw Error(fmt::format("{}: no such file", path.string()));
+  try {
+    Imf::InputFile file(path.c_str());
+    const Imath::Box2i dw = file.header().dataWindow();
+    const int w = dw.max.x - dw.min.x + 1, h = dw.max.y - dw.min.y + 1;
+    Image img(w, h);
+    const auto& channels = file.header().channels();
+    if (!channels.findChannel("R") && !channels.findChannel("G") && !channels.findChannel("B"))
+      throw Error("no R, G or B channel");
+    Imf::FrameBuffer fb;
+    const size_t xs = 3 * sizeof(float), ys = xs * w;
+    char* base = reinterpret_cast<char*>(img.rgb.data()) - (size_t(dw.min.x) * xs + size_t(dw.min.y) * ys);
+    fb.insert("R", Imf::Slice(Imf::FLOAT, base, xs, ys, 1, 1, 0.0));
+    fb.insert("G", Imf::Slice(Imf::FLOAT, base + sizeof(float), xs, ys, 1, 1, 0.0));
+    fb.insert("B", Imf::Slice(Imf::FLOAT, base + 2 * sizeof(float), xs, ys, 1, 1, 0.0));
+    file.setFrameBuffer(fb);
+    file.readPixels(dw.min.y, dw.max.y);
+    if (meta) {
+      meta->clear();
+      for (auto it = file.header().begin(); it != file.header().end(); ++it) {
+        if (const auto* s = dynamic_cast<const Imf::StringAttribute*>(&it.attribute()))
+          meta->emplace_back(it.name(), s->value());
+      }
+    }
+    return img;
+  } catch (const Error& e) {
+    throw Error(fmt::format("{}: {}", path.string(), e.what()));
+  } catch (const std::exception& e) {
+    throw Error(fmt::format("{}: cannot read EXR: {}", path.string(), e.what()));
+  }
+}
+
+void write_png(const fs::path& path, const Image& img, double exposure_stops) {
+  if (img.width <= 0 || img.height <= 0 || img.rgb.size() != size_t(img.width) * img.height * 3)
+    throw Error(fmt::format("{}: cannot write an empty or malformed image", path.string()));
+  const double scale = std::exp2(exposure_stops);
+  std::vector<uint8_t> pixels(img.rgb.size());
+  for (size_t i = 0; i < pixels.size(); ++i) {
+    const double v = double(img.rgb[i]) * scale;
+    pixels[i] = uint8_t(std::lround(255.0 * srgb_encode(std::isfinite(v) ? v : 0.0)));
+  }
+  png_image png{};
+  png.version = PNG_IMAGE_VERSION;
+  png.width = png_uint_32(img.width);
+  png.height = png_uint_32(img.height);
+  png.format = PNG_FORMAT_RGB;
+  png_alloc_size_t size = 0;
+  if (!png_image_write_to_memory(&png, nullptr, &size, 0, pixels.data(), 0, nullptr))
+    throw Error(fmt::format("{}: cannot encode PNG: {}", path.string(), png.message));
+  std::string bytes(size, '\0');
+  if (!png_image_write_to_memory(&png, bytes.data(), &size, 0, pixels.data(), 0, nullptr))
+    throw Error(fmt::format("{}: cannot encode PNG: {}", path.string(), png.message));
+  bytes.resize(size);
+  atomic_write_bytes(path, bytes);
+}
+
+void write_image(const fs::path& path, const Image& img, const ImageMetadata& meta, double exposure_stops) {
+  std::string ext = path.extension().string();
+  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+  if (ext == ".exr") return write_exr(path, img, meta);
+  if (ext == ".png") return write_png(path, img, exposure_stops);
+  throw Error(fmt::format("{}: unsupported output extension '{}' (use .exr or .png)", path.string(), ext));
+}
+
+}  // namespace nimbus

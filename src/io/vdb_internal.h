@@ -1,0 +1,31 @@
+// Shared between the NanoVDB side (vdb.cpp) and the OpenVDB side (vdb_openvdb.cpp) of the volume
+// reader. Not a public header.
+#pragma once
+
+#include <nanovdb/util/GridHandle.h>
+#include <nanovdb/util/HostBuffer.h>
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "io/vdb.h"
+
+namespace nimbus::detail {
+
+using NanoHandle = nanovdb::GridHandle<nanovdb::HostBuffer>;
+
+// "<file>: <what>" as a nimbus::Error.
+[[noreturn]] void fail(const std::filesystem::path& file, const std::string& what);
+
+// Reads the float grid `grid_name` ("" = the first float grid) of an OpenVDB file and converts it to
+// NanoVDB. Errors name the file; OpenVDB exceptions are rethrown as nimbus::Error.
+NanoHandle load_openvdb_float_grid(const std::filesystem::path& file, const std::string& grid_name);
+
+// Every grid of an OpenVDB file, for `nimbus info`.
+std::vector<GridInfo> inspect_openvdb_file(const std::filesystem::path& file);
+
+// Index bboxes with more voxels than this are rejected (a corrupt file or a grid we cannot brick).
+inline constexpr double kMaxBBoxVoxels = 2147483648.0;  // 2^31
+
+}  // namespace nimbus::detail

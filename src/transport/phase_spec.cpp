@@ -1,0 +1,104 @@
+#include "transport/phase_spec.h"
+
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "nimbus/error.h"
+
+namespace nimbus {
+
+namespace {
+
+std::vector<double> parse_numbers(const std::string& spec, const std::string& list, size_t count) {
+  std::vector<double> v;
+  std::stringstream ss(list);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    size_t used = 0;
+    double x = 0.0;
+    try {
+      x = std::stod(item, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != item.size() || !std::isfinite(x))
+      throw Error(fmt::format("phase '{}': '{}' is not a number", spec, item));
+    v.push_back(x);
+  }
+  if (v.size() != count) throw Error(fmt::format("phase '{}': expected {} number(s), got {}", spec, count, v.size()));
+  return v;
+}
+
+void check_g(const std::string& spec, double g) {
+  if (!(g > -1.0 && g < 1.0)) throw Error(fmt::format("phase '{}': asymmetry g must lie in (-1, 1)", spec));
+}
+
+}  // namespace
+
+std::string phase_table_dir() {
+  if (const char* d = std::getenv("NIMBUS_DATA_DIR"); d && *d) return std::string(d) + "/phase";
+  return std::string(NIMBUS_SOURCE_DIR) + "/data/phase";
+}
+
+TabulatedPhase load_phase_table(const std::string& name, const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw Error(fmt::format("phase table '{}': cannot open {}", name, path));
+  std::vector<double> theta, value;
+  std::string line;
+  int row = 0;
+  while (std::getline(in, line)) {
+    ++row;
+    if (line.empty() || line[0] == '#') continue;
+    double t = 0.0, v = 0.0;
+    char comma = 0;
+    std::istringstream ls(line);
+    if (!(ls >> t >> comma >> v) || comma != ',') {
+      if (theta.empty()) continue;  // a header line before the data
+      throw Error(fmt::format("{}:{}: expected 'theta,value'", path, row));
+    }
+    theta.push_back(t);
+    value.push_back(v);
+  }
+  return make_tabulated_phase(name, std::move(theta), std::move(value));
+}
+
+Phase parse_phase_spec(const std::string& spec) {
+  const size_t colon = spec.find(':');
+  const std::string kind = spec.substr(0, colon);
+  const std::string args = colon == std::string::npos ? "" : spec.substr(colon + 1);
+  if (kind == "iso" || kind == "isotropic") {
+    if (colon != std::string::npos) throw Error(fmt::format("phase '{}': iso takes no parameters", spec));
+    return IsotropicPhase{};
+  }
+  if (kind == "hg") {
+    const double g = parse_numbers(spec, args, 1)[0];
+    check_g(spec, g);
+    return HgPhase{g};
+  }
+  if (kind == "dhg") {
+    const auto v = parse_numbers(spec, args, 3);
+    check_g(spec, v[0]);
+    check_g(spec, v[1]);
+    if (!(v[2] >= 0.0 && v[2] <= 1.0)) throw Error(fmt::format("phase '{}': weight W must lie in [0, 1]", spec));
+    return DoubleHgPhase{v[0], v[1], v[2]};
+  }
+  if (kind == "gauss") {
+    const double t = parse_numbers(spec, args, 1)[0];
+    if (!(t > 0.0 && t < 1.0)) throw Error(fmt::format("phase '{}': theta2 must lie in (0, 1)", spec));
+    return make_gauss_phase(t);
+  }
+  if (kind == "mie") {
+    if (args.empty() || args.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-.") != std::string::npos ||
+        args[0] == '.')
+      throw Error(fmt::format("phase '{}': mie needs a table name of letters, digits, '_', '-', '.'", spec));
+    return load_phase_table(args, phase_table_dir() + "/" + args + ".csv");
+  }
+  throw Error(fmt::format("phase '{}': unknown type (use iso, hg:G, dhg:G1,G2,W, gauss:THETA2 or mie:NAME)", spec));
+}
+
+}  // namespace nimbus

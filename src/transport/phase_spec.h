@@ -1,0 +1,21 @@
+// Phase functions from short command-line specs: `iso`, `hg:G`, `dhg:G1,G2,W`, `gauss:THETA2`,
+// `mie:NAME` (the table data/phase/NAME.csv under $NIMBUS_DATA_DIR, else under the source tree).
+#pragma once
+
+#include <string>
+
+#include "media/phase.h"
+
+namespace nimbus {
+
+// Throws nimbus::Error naming the spec on anything malformed or out of range.
+Phase parse_phase_spec(const std::string& spec);
+
+// Loads a two-column CSV table (theta in radians from 0 to pi, value per sr; a header line and lines
+// starting with '#' are skipped) as a normalised TabulatedPhase.
+TabulatedPhase load_phase_table(const std::string& name, const std::string& path);
+
+// The directory holding phase tables: $NIMBUS_DATA_DIR/phase if set, else NIMBUS_SOURCE_DIR/data/phase.
+std::string phase_table_dir();
+
+}  // namespace nimbus

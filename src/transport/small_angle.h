@@ -1,0 +1,80 @@
+// The generalised forward propagator: multiple forward scattering for phase functions that are not
+// Gaussian (Henyey-Greenstein, double HG, tabulated Mie), where the closed-form MFS kernel fails
+// (../shared/notes/mfs-math.md, "The big caveat").  Pure math, no scene.  This is what the `mfs`
+// renderer calls for the forward-scattered light along a path.
+//
+// Model ("gsa", generalised small-angle; validated in docs/validation/beam.md):
+//  - ANGLE.  After a path with optical depths tau_s, tau_a the scattered light's direction density is
+//        I(theta) = sum_l (2l + 1)/(4 pi) f_l P_l(cos theta),
+//        f_l = exp(-tau_a) [exp(-tau_s (1 - chi_l)) - exp(-tau_s)],
+//    chi_l the Legendre moments of the phase function (chi_0 = 1).  This is the exact solution on the
+//    sphere of "n scatters are Poisson(tau_s) distributed along the path" (Funk-Hecke: convolving phase
+//    functions multiplies their moments); for HG (chi_l = g^l) it is precisely the HG-Poisson series
+//    sum_n Poisson(n; tau_s) HG(theta; g^n) exp(-tau_a) of the notes.  It neglects only that depth is
+//    shorter than path length (forward-dominated light: a small effect, measured in the docs).
+//  - SPACE.  The transverse spread uses the small-angle solution of the transfer equation for the
+//    actual Fourier-transformed phase function Z(q) (seed eq. 4 with Z not expanded):
+//        R(k) = exp(-tau_a - tau_s) [exp(tau_s Zbar(k)) - 1],  Zbar(k) = (1/z) int_0^z Z(k u) du,
+//    whose inverse 2-D Fourier (Hankel) transform is the density per unit area.  Z(q) is taken from the
+//    same moments through Hilb's asymptotics, Z(l + 1/2) ~ chi_l.  Radii are in scattering mean free
+//    paths of the path (r_mfp = r tau_s / z for a path of physical length z).  As in every small-angle
+//    solution all scattered light is carried forward: radial_within(infinity) = total(), not the smaller
+//    forward_flux() (the light near the axis, which dominates the profile, is forward light).
+// Integrals of the radial profile are done by numerical Hankel transforms with an analytic tail.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "media/phase.h"
+
+namespace nimbus {
+
+// Legendre moments chi_l = 2 pi int P(mu) P_l(mu) dmu, l = 0..L, chi_0 = 1; closed forms for HG and
+// double HG, quadrature otherwise.  Stops once |chi_l| < tol for 8 consecutive l, or at l_cap.
+std::vector<double> phase_legendre_moments(const Phase& phase, double tol = 1e-12, int l_cap = 6000);
+
+// The per-component mean square deflection theta2 = <sin^2 theta> / 2 = (1 - chi_2) / 3 used to give a
+// non-Gaussian phase function a Gaussian stand-in ((1 - g^2)/3 for HG); the Gaussian peak's own theta2.
+double phase_theta2(const Phase& phase);
+
+class ForwardPropagator;
+
+// The scattered light after one path: what the renderer asks for.
+class ForwardProfile {
+ public:
+  double total() const { return total_; }                // scattered unabsorbed power, all directions
+  double forward_flux() const { return forward_flux_; }  // its flux through the plane (cos-weighted, theta < pi/2)
+  // Plane-integrated radiance per steradian of the scattered light at polar angle theta [rad].
+  double angular(double theta) const;
+  // Scattered power within the cone of half-angle theta.
+  double angular_within(double theta) const;
+  // Forward scattered flux per unit area at transverse radius r [mean free paths].
+  double radial(double r) const;
+  // Forward scattered flux within radius r [mean free paths].
+  double radial_within(double r) const;
+
+ private:
+  friend class ForwardPropagator;
+  std::vector<double> f_;  // f_l
+  std::shared_ptr<const std::vector<double>> cumulative_z_;  // int_0^(i) Z(q) dq at integer q
+  double tau_s_ = 0.0, tau_a_ = 0.0, total_ = 0.0, forward_flux_ = 0.0;
+  double spectrum(double k) const;        // R(k)
+  double spectrum_slope(double k) const;  // dR/dk
+  double zbar_and_z(double k, double* z_at) const;
+};
+
+// Built once per phase function (a few ms to ~0.5 s for a sharp tabulated Mie peak), then cheap.
+class ForwardPropagator {
+ public:
+  explicit ForwardPropagator(const Phase& phase);
+  // The scattered light after optical depths tau_s (scattering) and tau_a (absorption) along a path.
+  ForwardProfile profile(double tau_s, double tau_a) const;
+  const std::vector<double>& moments() const { return chi_; }
+
+ private:
+  std::vector<double> chi_;
+  std::shared_ptr<const std::vector<double>> cumulative_z_;
+};
+
+}  // namespace nimbus

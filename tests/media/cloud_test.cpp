@@ -1,0 +1,60 @@
+// The procedural cloud: deterministic, bounded, and a real cloud (a substantial, connected body).
+#include <gtest/gtest.h>
+
+#include "io/scene_volumes.h"
+#include "io/vdb.h"
+#include "media/cloud.h"
+
+namespace nimbus {
+namespace {
+
+TEST(Cloud, DensityIsDeterministicAndBounded) {
+  double inside = 0.0, total = 0.0;
+  const int n = 40;
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j)
+      for (int k = 0; k < n; ++k) {
+        const Vec3 p((i + 0.5) / n * 2 - 1, (j + 0.5) / n * 2 - 1, (k + 0.5) / n * 2 - 1);
+        const double d = procedural_cloud_density(p, 7);
+        ASSERT_GE(d, 0.0);
+        ASSERT_LE(d, 1.0);
+        ASSERT_EQ(d, procedural_cloud_density(p, 7));
+        if (p.length() > 0.98) ASSERT_EQ(d, 0.0);
+        inside += d > 0.0;
+        total += 1;
+      }
+  // A cumulus fills a good part of its bounding ball but not all of it.
+  EXPECT_GT(inside / total, 0.05);
+  EXPECT_LT(inside / total, 0.45);
+  EXPECT_GT(procedural_cloud_density(Vec3(0, 0, 0), 7), 0.5);
+  // Another seed gives another cloud.
+  int differ = 0;
+  for (int i = 0; i < 1000; ++i) {
+    const Vec3 p(std::sin(i * 1.1) * 0.7, std::cos(i * 0.7) * 0.7, std::sin(i * 0.3) * 0.5);
+    differ += procedural_cloud_density(p, 7) != procedural_cloud_density(p, 8);
+  }
+  EXPECT_GT(differ, 100);
+}
+
+TEST(Cloud, VoxelisedGridMatchesTheDensity) {
+  CloudShape c;
+  c.center = Vec3(1, 2, 3);
+  c.radius = 2.0;
+  c.seed = 7;
+  c.resolution = 48;
+  build_cloud_shape(c);
+  const DensityGrid& g = *c.data;
+  std::printf("cloud: %llu active voxels, mean %.3f, max %.3f\n", (unsigned long long)g.stats().active_voxels,
+              g.stats().mean_active, g.stats().max_value);
+  // At voxel centres the grid holds the density.
+  for (int i = 3; i < 45; i += 7)
+    for (int j = 3; j < 45; j += 5)
+      for (int k = 3; k < 45; k += 6) {
+        const Vec3 world = g.index_to_world(Vec3(i, j, k));
+        const Vec3 unit = (world - c.center) / c.radius;
+        EXPECT_NEAR(g.density_index(Vec3(i, j, k)), procedural_cloud_density(unit, 7), 1e-6);
+      }
+}
+
+}  // namespace
+}  // namespace nimbus

@@ -1,0 +1,146 @@
+// `nimbus beam` and `nimbus slab` run as a user would: the CSV layout and lines they promise, atomic
+// output, and exit code 2 with a clear message on bad arguments.
+#include <sys/wait.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+namespace {
+
+struct CliRun {
+  int rc = -1;
+  std::string out;  // stdout and stderr together
+};
+
+CliRun run(const std::string& args) {
+  CliRun r;
+  const std::string cmd = std::string(NIMBUS_CLI) + " " + args + " 2>&1";
+  FILE* p = popen(cmd.c_str(), "r");
+  if (!p) return r;
+  char buf[4096];
+  size_t n;
+  while ((n = fread(buf, 1, sizeof buf, p)) > 0) r.out.append(buf, n);
+  const int status = pclose(p);
+  r.rc = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+std::filesystem::path temp_dir() {
+  auto d = std::filesystem::temp_directory_path() / ("nimbus_cli_test_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(d);
+  return d;
+}
+
+TEST(CliBeam, WritesTheDocumentedCsv) {
+  const auto dir = temp_dir();
+  const auto out = dir / "beam.csv";
+  const CliRun r = run("beam --phase hg:0.9 --albedo 0.99 --depths 1,3 --photons 2000 --theta-edges 0,0.01,0.1,1,3.14159 "
+                    "--r-edges 0,0.1,1,10 -o " + out.string());
+  ASSERT_EQ(r.rc, 0) << r.out;
+  std::ifstream in(out);
+  std::string line;
+  std::getline(in, line);
+  EXPECT_EQ(line, "model,depth,quantity,lo,hi,value,stderr");
+  std::map<std::string, int> rows_per_model;
+  std::set<std::string> quantities;
+  while (std::getline(in, line)) {
+    std::stringstream ss(line);
+    std::string model, depth, quantity, lo, hi, value, err;
+    std::getline(ss, model, ',');
+    std::getline(ss, depth, ',');
+    std::getline(ss, quantity, ',');
+    std::getline(ss, lo, ',');
+    std::getline(ss, hi, ',');
+    std::getline(ss, value, ',');
+    std::getline(ss, err, ',');
+    ++rows_per_model[model];
+    quantities.insert(quantity);
+    EXPECT_TRUE(std::isfinite(std::stod(value))) << line;
+    if (quantity == "unscattered") {
+      EXPECT_EQ(std::stod(lo), 0.0);
+      EXPECT_EQ(std::stod(hi), 0.0);
+      if (model != "mc") {
+        EXPECT_NEAR(std::stod(value), std::exp(-std::stod(depth) / 0.99), 1e-8);
+      }
+    }
+  }
+  // Every model by default; per depth 4 angular + 3 radial + 1 unscattered rows.
+  for (const char* m : {"mc", "dolin", "tes87", "mfs", "gsa"}) EXPECT_EQ(rows_per_model[m], 2 * 8) << m;
+  EXPECT_EQ(quantities, (std::set<std::string>{"angular", "radial", "unscattered"}));
+  // No temporary file left beside the output.
+  int files = 0;
+  for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(dir)) ++files;
+  EXPECT_EQ(files, 1);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(CliBeam, ModelsSubsetSlabAndSeed) {
+  const CliRun a = run("beam --phase gauss:0.01 --albedo 0.9 --depths 1 --geometry slab:2 --n 1.33 --photons 500 "
+                    "--models mc --theta-edges 0,0.1,3.14159 --r-edges 0,1 --seed 7");
+  const CliRun b = run("beam --phase gauss:0.01 --albedo 0.9 --depths 1 --geometry slab:2 --n 1.33 --photons 500 "
+                    "--models mc --theta-edges 0,0.1,3.14159 --r-edges 0,1 --seed 7");
+  ASSERT_EQ(a.rc, 0) << a.out;
+  EXPECT_EQ(a.out, b.out);
+  EXPECT_EQ(a.out.find("gsa"), std::string::npos);
+  EXPECT_NE(a.out.find("mc,1,angular,0,0.1,"), std::string::npos) << a.out;
+}
+
+TEST(CliBeam, BadArgumentsExitWithCode2AndAMessage) {
+  const std::string base = " --depths 1,3 --photons 100";
+  const std::pair<std::string, std::string> cases[] = {
+      {"beam --phase hg:1.5 --albedo 0.9" + base, "asymmetry"},
+      {"beam --phase foo:1 --albedo 0.9" + base, "unknown type"},
+      {"beam --phase hg:abc --albedo 0.9" + base, "not a number"},
+      {"beam --phase dhg:0.9,0.1 --albedo 0.9" + base, "expected 3"},
+      {"beam --phase mie:no_such_table --albedo 0.9" + base, "cannot open"},
+      {"beam --phase mie:../x --albedo 0.9" + base, "table name"},
+      {"beam --phase hg:0.9 --albedo -0.1" + base, "albedo"},
+      {"beam --phase hg:0.9 --albedo 1.5" + base, "albedo"},
+      {"beam --phase hg:0.9 --albedo 0.9 --depths 3,1", "increase"},
+      {"beam --phase hg:0.9 --albedo 0.9 --depths 1,x", "not a number"},
+      {"beam --phase hg:0.9 --albedo 0.9 --depths 1 --models mc,foo", "unknown model"},
+      {"beam --phase hg:0.9 --albedo 0.9 --depths 1 --geometry slab:0.5", "inside the slab"},
+      {"beam --phase hg:0.9 --albedo 0.9 --depths 1 --geometry cube", "geometry"},
+      {"beam --phase hg:0.9 --albedo 0.9 --depths 1 --n 1.33", "slab"},
+      {"beam --phase hg:0.9 --albedo 0.9 --depths 1 --theta-edges 0.2,0.1", "increase"},
+      {"beam --albedo 0.9 --depths 1", "phase"},
+      {"slab --mu-s 10 --mu-a 1 --g 1.2 --thickness 1", "--g"},
+      {"slab --mu-s -10 --mu-a 1 --g 0.9 --thickness 1", "--mu-s"},
+      {"slab --mu-s 10 --mu-a 1 --g 0.9 --thickness 0", "--thickness"},
+      {"slab --mu-s 10 --mu-a 1 --g 0.9 --thickness 1 --n 0.5", "--n"},
+  };
+  for (const auto& [args, needle] : cases) {
+    const CliRun r = run(args);
+    EXPECT_EQ(r.rc, 2) << args << "\n" << r.out;
+    EXPECT_NE(r.out.find(needle), std::string::npos) << args << "\n" << r.out;
+  }
+}
+
+TEST(CliSlab, PrintsTheFiveTotalsThatBalance) {
+  const CliRun r = run("slab --mu-s 100 --mu-a 0.1 --g 0.9 --thickness 0.1 --n 1.33 --photons 5000");
+  ASSERT_EQ(r.rc, 0) << r.out;
+  std::stringstream ss(r.out);
+  std::map<std::string, double> v;
+  std::string name;
+  double value, err;
+  while (ss >> name >> value >> err) v[name] = value;
+  ASSERT_EQ(v.size(), 5u) << r.out;
+  EXPECT_NEAR(v["specular"], std::pow(0.33 / 2.33, 2), 1e-7);
+  EXPECT_NEAR(v["specular"] + v["diffuse_reflectance"] + v["transmittance"] + v["absorbed"], 1.0, 1e-3);
+  EXPECT_LE(v["unscattered_transmittance"], v["transmittance"]);
+  const CliRun c = run("slab --mu-s 100 --mu-a 0.1 --g 0.9 --thickness 0.1 --photons 500 --csv --angle-bins 3 --r-bins 2");
+  ASSERT_EQ(c.rc, 0) << c.out;
+  EXPECT_NE(c.out.find("side,quantity,lo,hi,value,stderr"), std::string::npos);
+  EXPECT_NE(c.out.find("transmit,radial,"), std::string::npos);
+}
+
+}  // namespace
