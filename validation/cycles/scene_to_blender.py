@@ -1,0 +1,326 @@
+"""Build a nimbus scene JSON in Blender Cycles and render it (run inside Blender).
+
+    blender -b --factory-startup --python validation/cycles/scene_to_blender.py -- \
+        SCENE.json OUT.exr [--samples N] [--seed S] [--threads T] [--npy OUT.npy] [--blend OUT.blend]
+
+Writes a linear float32 RGB OpenEXR (and, with --npy, the same pixels as a (height, width, 3)
+float32 array, row 0 = top like nimbus) so that /usr/bin/python3 can compare without OpenEXR.
+
+Mapping (docs/validation/cycles.md explains and checks each line):
+  camera       pinhole, sensor fit VERTICAL, angle_y = fov_y_deg; rotation from the nimbus basis
+               right = forward x up, up' = right x forward (Blender cameras look down local -Z,
+               local +Y up); resolution width x height at 100 %, box pixel filter 1 px wide.
+  media        homogeneous only (sphere, box). Volume Scatter gives sigma_s = Color * Density,
+               Volume Absorption gives sigma_a = (1 - Color) * Density (Cycles svm_node_closure_volume),
+               so Color = sigma/max(sigma), Density = max(sigma) per closure, added with an Add Shader.
+               Phase: Anisotropy = HG g; double_hg would be two Volume Scatter closures with
+               densities w * sigma_s and (1 - w) * sigma_s, but Cycles 3.4 gets their weights
+               wrong (refused unless --allow-multi-lobe). Box = cube mesh (exact); sphere = UV sphere whose
+               radius is scaled so that the polyhedron's volume equals the sphere's (deviation reported).
+  directional  SUN lamp, Strength = irradiance (W/m^2), Color = irradiance / max, angle = angular
+               diameter (use 0: Cycles' disc radiance is S/(pi tan^2(a/2)), nimbus' S/(pi sin^2(a/2))).
+  point        POINT lamp, radius 0, Power P = 4 pi I (Cycles: I = P / (4 pi) W/sr, eval_fac = 1/(4 pi)).
+  environment  World Background, Color = radiance, Strength 1 (black world without one).
+  integrator   max_events 0 -> volume bounces 1024; max_events k -> volume bounces k - 1.
+"""
+import argparse
+import json
+import math
+import sys
+
+import bmesh
+import bpy
+import numpy as np
+from mathutils import Matrix, Vector
+
+
+def parse_args():
+    argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
+    p = argparse.ArgumentParser(prog="scene_to_blender.py")
+    p.add_argument("scene")
+    p.add_argument("output", help="output .exr")
+    p.add_argument("--samples", type=int, default=None, help="default: the scene's integrator.spp")
+    p.add_argument("--seed", type=int, default=None, help="Cycles seed (default: the scene's seed)")
+    p.add_argument("--threads", type=int, default=2)
+    p.add_argument("--sphere-segments", type=int, default=256,
+                   help="UV sphere segments around (rings = segments / 2)")
+    p.add_argument("--npy", default=None, help="also save the pixels as (h, w, 3) float32 .npy")
+    p.add_argument("--blend", default=None, help="also save the built .blend (debugging)")
+    p.add_argument("--allow-multi-lobe", action="store_true",
+                   help="render double_hg as two Volume Scatter closures although Cycles 3.4 gets it wrong")
+    return p.parse_args(argv)
+
+
+ALLOW_MULTI_LOBE = False
+
+
+def rgb(value):
+    """A nimbus number-or-[r, g, b] as a 3-tuple of floats."""
+    if isinstance(value, (int, float)):
+        return (float(value),) * 3
+    if len(value) != 3:
+        raise ValueError(f"expected a number or [r, g, b], got {value!r}")
+    return tuple(float(v) for v in value)
+
+
+def color_and_scale(value):
+    """Split an RGB coefficient into (colour with max 1, scale = max) as Blender's nodes want."""
+    c = rgb(value)
+    m = max(c)
+    if m <= 0.0:
+        return (0.0, 0.0, 0.0), 0.0
+    return tuple(v / m for v in c), m
+
+
+def link(obj):
+    bpy.context.scene.collection.objects.link(obj)
+    return obj
+
+
+# --- Camera -----------------------------------------------------------------------------------
+def build_camera(cam):
+    scene = bpy.context.scene
+    data = bpy.data.cameras.new("camera")
+    data.type = "PERSP"
+    data.sensor_fit = "VERTICAL"
+    data.angle_y = math.radians(cam["fov_y_deg"])
+    data.shift_x = data.shift_y = 0.0
+    data.clip_start = 1e-4
+    data.clip_end = 1e7
+    obj = link(bpy.data.objects.new("camera", data))
+    pos = Vector(cam["position"])
+    forward = (Vector(cam["look_at"]) - pos).normalized()
+    right = forward.cross(Vector(cam.get("up", [0, 0, 1]))).normalized()
+    up = right.cross(forward)
+    # Blender camera: local +X right, +Y up, looks down -Z.
+    rot = Matrix((right, up, -forward)).transposed()
+    obj.matrix_world = Matrix.Translation(pos) @ rot.to_4x4()
+    scene.camera = obj
+    scene.render.resolution_x = cam["width"]
+    scene.render.resolution_y = cam["height"]
+    scene.render.resolution_percentage = 100
+    scene.render.pixel_aspect_x = scene.render.pixel_aspect_y = 1.0
+    return {"angle_y_deg": math.degrees(data.angle_y)}
+
+
+# --- Media ------------------------------------------------------------------------------------
+def volume_material(name, medium):
+    mat = bpy.data.materials.new(name)
+    mat.use_nodes = True
+    nt = mat.node_tree
+    nt.nodes.clear()
+    out = nt.nodes.new("ShaderNodeOutputMaterial")
+    closures = []
+    phase = medium.get("phase", {"type": "isotropic"})
+    kind = phase.get("type", "isotropic")
+    if kind == "isotropic":
+        lobes = [(1.0, 0.0)]
+    elif kind == "hg":
+        lobes = [(1.0, float(phase["g"]))]
+    elif kind == "double_hg":
+        w = float(phase["w"])
+        lobes = [(w, float(phase["g1"])), (1.0 - w, float(phase["g2"]))]
+        if 0.0 < w < 1.0 and not ALLOW_MULTI_LOBE:
+            # Measured against single_scatter_reference.py: Cycles 3.4 weighs two added Volume
+            # Scatter closures equally in light sampling (2.000x for w = 0.5 or g1 = g2).
+            raise ValueError(f"{name}: double_hg needs two Volume Scatter closures, which Cycles 3.4 "
+                             "does not weigh correctly (docs/validation/cycles.md); "
+                             "--allow-multi-lobe renders it anyway")
+    else:
+        raise ValueError(f"{name}: phase '{kind}' has no Cycles equivalent")
+    color, scale = color_and_scale(medium["sigma_s"])
+    for weight, g in lobes:
+        if scale * weight <= 0.0:
+            continue
+        s = nt.nodes.new("ShaderNodeVolumeScatter")
+        s.inputs["Color"].default_value = (*color, 1.0)
+        s.inputs["Density"].default_value = scale * weight
+        s.inputs["Anisotropy"].default_value = g
+        closures.append(s.outputs[0])
+    acolor, ascale = color_and_scale(medium.get("sigma_a", 0.0))
+    if ascale > 0.0:
+        a = nt.nodes.new("ShaderNodeVolumeAbsorption")
+        a.inputs["Color"].default_value = (*(1.0 - v for v in acolor), 1.0)
+        a.inputs["Density"].default_value = ascale
+        closures.append(a.outputs[0])
+    while len(closures) > 1:
+        add = nt.nodes.new("ShaderNodeAddShader")
+        nt.links.new(closures.pop(), add.inputs[1])
+        nt.links.new(closures.pop(), add.inputs[0])
+        closures.append(add.outputs[0])
+    if closures:
+        nt.links.new(closures[0], out.inputs["Volume"])
+    mat.cycles.homogeneous_volume = True
+    return mat
+
+
+def sphere_mesh(name, radius, segments):
+    bm = bmesh.new()
+    bmesh.ops.create_uvsphere(bm, u_segments=segments, v_segments=segments // 2, radius=1.0)
+    unit_volume = bm.calc_volume()
+    # Scale so that the polyhedron holds the sphere's volume (its vertices lie slightly outside).
+    k = (4.0 / 3.0 * math.pi / unit_volume) ** (1.0 / 3.0)
+    bmesh.ops.scale(bm, vec=Vector((k * radius,) * 3), verts=bm.verts)
+    r = [v.co.length for v in bm.verts]
+    info = {"faces": len(bm.faces), "volume_scale": k ** 3,
+            "vertex_radius_rel": max(r) / radius - 1.0}
+    # Faces are flat: the distance of face centres from the centre bounds the inner deviation.
+    info["face_centre_radius_rel"] = min(f.calc_center_median().length for f in bm.faces) / radius - 1.0
+    mesh = bpy.data.meshes.new(name)
+    bm.to_mesh(mesh)
+    bm.free()
+    return mesh, info
+
+
+def box_mesh(name, lo, hi):
+    bm = bmesh.new()
+    bmesh.ops.create_cube(bm, size=1.0)
+    for v in bm.verts:
+        v.co = Vector(tuple(lo[i] + (v.co[i] + 0.5) * (hi[i] - lo[i]) for i in range(3)))
+    mesh = bpy.data.meshes.new(name)
+    bm.to_mesh(mesh)
+    bm.free()
+    return mesh
+
+
+def build_media(media, segments):
+    notes = []
+    for i, medium in enumerate(media):
+        shape = medium["shape"]
+        name = f"medium{i}"
+        if shape["type"] == "sphere":
+            mesh, info = sphere_mesh(name, float(shape["radius"]), segments)
+            obj = link(bpy.data.objects.new(name, mesh))
+            obj.location = Vector(shape.get("center", [0, 0, 0]))
+            notes.append({name: info})
+        elif shape["type"] == "box":
+            obj = link(bpy.data.objects.new(name, box_mesh(name, shape["min"], shape["max"])))
+            notes.append({name: "cube mesh (exact)"})
+        else:
+            raise ValueError(f"{name}: shape '{shape['type']}' is not supported (homogeneous sphere/box only)")
+        obj.data.materials.append(volume_material(name, medium))
+    return notes
+
+
+# --- Lights -----------------------------------------------------------------------------------
+def build_lights(lights):
+    scene = bpy.context.scene
+    world = bpy.data.worlds.new("world")
+    world.use_nodes = True
+    bg = world.node_tree.nodes["Background"]
+    bg.inputs["Color"].default_value = (0.0, 0.0, 0.0, 1.0)
+    bg.inputs["Strength"].default_value = 0.0
+    scene.world = world
+    for i, light in enumerate(lights):
+        kind = light["type"]
+        if kind == "directional":
+            color, scale = color_and_scale(light["irradiance"])
+            data = bpy.data.lights.new(f"sun{i}", "SUN")
+            data.energy = scale  # W/m^2 on a plane facing the sun
+            data.color = color
+            data.angle = math.radians(light.get("angular_diameter_deg", 0.0))
+            obj = link(bpy.data.objects.new(f"sun{i}", data))
+            # Sun lamps shine down their local -Z: point local +Z against the travel direction.
+            obj.rotation_euler = (-Vector(light["direction"]).normalized()).to_track_quat("Z", "Y").to_euler()
+        elif kind == "point":
+            color, scale = color_and_scale(light["intensity"])
+            data = bpy.data.lights.new(f"point{i}", "POINT")
+            data.energy = 4.0 * math.pi * scale  # Cycles: intensity = power / (4 pi) W/sr
+            data.color = color
+            data.shadow_soft_size = 0.0
+            obj = link(bpy.data.objects.new(f"point{i}", data))
+            obj.location = Vector(light["position"])
+        elif kind == "environment":
+            bg.inputs["Color"].default_value = (*rgb(light["radiance"]), 1.0)
+            bg.inputs["Strength"].default_value = 1.0
+        else:
+            raise ValueError(f"light {i}: type '{kind}' is not supported")
+
+
+# --- Render settings --------------------------------------------------------------------------
+def configure(args, integrator):
+    scene = bpy.context.scene
+    scene.render.engine = "CYCLES"
+    c = scene.cycles
+    c.device = "CPU"
+    c.samples = args.samples or int(integrator.get("spp", 64))
+    c.seed = args.seed if args.seed is not None else int(integrator.get("seed", 1))
+    c.use_animated_seed = False
+    c.sample_offset = 0
+    c.use_adaptive_sampling = False
+    c.use_denoising = False
+    c.use_preview_denoising = False
+    c.pixel_filter_type = "BOX"
+    c.filter_width = 1.0
+    c.sample_clamp_direct = 0.0
+    c.sample_clamp_indirect = 0.0  # Blender's default is 10: it would clip bright paths
+    c.light_sampling_threshold = 0.0  # default 0.01 culls dim lights: biased
+    max_events = int(integrator.get("max_events", 0))
+    c.max_bounces = 1024
+    c.volume_bounces = 1024 if max_events == 0 else max_events - 1
+    c.diffuse_bounces = c.glossy_bounces = c.transmission_bounces = 1024
+    c.transparent_max_bounces = 1024
+    c.min_light_bounces = 0
+    c.min_transparent_bounces = 0
+    c.blur_glossy = 0.0
+    c.caustics_reflective = True
+    c.caustics_refractive = True
+    c.film_exposure = 1.0
+    c.scrambling_distance = 1.0
+    c.auto_scrambling_distance = False
+    c.use_fast_gi = False
+    scene.render.threads_mode = "FIXED"
+    scene.render.threads = args.threads
+    scene.render.film_transparent = False
+    scene.render.use_motion_blur = False
+    scene.render.use_compositing = False
+    scene.render.use_sequencer = False
+    scene.render.dither_intensity = 0.0
+    vs = scene.view_settings
+    vs.view_transform = "Standard"
+    vs.look = "None"
+    vs.exposure = 0.0
+    vs.gamma = 1.0
+    vs.use_curve_mapping = False
+    im = scene.render.image_settings
+    im.file_format = "OPEN_EXR"
+    im.color_mode = "RGB"
+    im.color_depth = "32"
+    im.exr_codec = "ZIP"
+
+
+def exr_to_array(path):
+    """Pixels of an EXR as (h, w, 3) float32, row 0 = top."""
+    img = bpy.data.images.load(path, check_existing=False)
+    w, h = img.size
+    buf = np.empty(w * h * 4, dtype=np.float32)
+    img.pixels.foreach_get(buf)
+    bpy.data.images.remove(img)
+    return buf.reshape(h, w, 4)[::-1, :, :3].copy()
+
+
+def main():
+    global ALLOW_MULTI_LOBE
+    args = parse_args()
+    ALLOW_MULTI_LOBE = args.allow_multi_lobe
+    with open(args.scene) as f:
+        scene_json = json.load(f)
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    cam_info = build_camera(scene_json["camera"])
+    mesh_info = build_media(scene_json.get("media", []), args.sphere_segments)
+    build_lights(scene_json.get("lights", []))
+    configure(args, scene_json.get("integrator", {}))
+    print("scene_to_blender:", json.dumps({"camera": cam_info, "media": mesh_info,
+                                           "samples": bpy.context.scene.cycles.samples,
+                                           "seed": bpy.context.scene.cycles.seed,
+                                           "volume_bounces": bpy.context.scene.cycles.volume_bounces}))
+    if args.blend:
+        bpy.ops.wm.save_as_mainfile(filepath=args.blend)
+    bpy.context.scene.render.filepath = args.output
+    bpy.ops.render.render(write_still=True)
+    if args.npy:
+        np.save(args.npy, exr_to_array(args.output))
+
+
+if __name__ == "__main__":
+    main()
