@@ -93,7 +93,10 @@ def stats(n1, n2, c1, c2, k, ref=None):
     s["rmse_ratio"] = s["rel_rmse"] / s["rel_rmse_floor"]
     # Map of the channel sum (channels are correlated: their variances do not simply add).
     vsum = binned(((n1 - n2).sum(-1, keepdims=True) ** 2 + (c1 - c2).sum(-1, keepdims=True) ** 2) / 4, k) / (k * k)
-    s["bin_z"] = (Nb - Cb).sum(-1) / np.sqrt(np.maximum(vsum[..., 0], 1e-30))
+    # Bins without noise (background seen directly: both renderers return the environment exactly)
+    # carry no statistical information: NaN, drawn grey.
+    with np.errstate(divide="ignore", invalid="ignore"):
+        s["bin_z"] = np.where(vsum[..., 0] > 0, (Nb - Cb).sum(-1) / np.sqrt(vsum[..., 0]), np.nan)
     if ref is not None:
         s["mean_reference"] = ref.mean((0, 1))
         for key, X, v in (("nimbus", N, vN), ("cycles", C, vC)):
@@ -117,7 +120,9 @@ def save_png(path, name, N, C, bin_z):
     ax[0].set_title(f"{name}: nimbus", fontsize=9)
     ax[1].imshow(tone(C), interpolation="nearest")
     ax[1].set_title("Cycles 3.4", fontsize=9)
-    im = ax[2].imshow(bin_z, cmap="RdBu_r", vmin=-4, vmax=4, interpolation="nearest")
+    cmap = matplotlib.colormaps["RdBu_r"].copy()
+    cmap.set_bad("0.7")
+    im = ax[2].imshow(np.ma.masked_invalid(bin_z), cmap=cmap, vmin=-4, vmax=4, interpolation="nearest")
     ax[2].set_title("(nimbus - Cycles) / sigma, RGB sum,\n4x4 bins", fontsize=8)
     fig.colorbar(im, ax=ax[2], fraction=0.046, pad=0.04)
     for a in ax:
