@@ -12,18 +12,13 @@
 #include <thread>
 
 #include "nimbus/image.h"
+#include "support/scratch_dir.h"
 
 namespace nimbus {
 namespace {
 
 namespace fs = std::filesystem;
 
-fs::path fresh_dir(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("nimbus_render_cli_" + name);
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
 
 void write_scene(const fs::path& file, int size, int spp) {
   std::ofstream(file) << R"({"camera": {"position": [0, -4, 0], "look_at": [0, 0, 0], "up": [0, 0, 1],
@@ -47,7 +42,8 @@ std::string meta_value(const ImageMetadata& meta, const std::string& key) {
 }
 
 TEST(RenderCli, WritesExrWithHeaderAndPreview) {
-  const fs::path dir = fresh_dir("ok");
+  const test::ScratchDir scratch("render_cli_ok");
+  const fs::path& dir = scratch.path;
   write_scene(dir / "s.json", 16, 2);
   ASSERT_EQ(run("render " + (dir / "s.json").string() + " -o " + (dir / "a.exr").string() + " --preview " +
                 (dir / "a.png").string() + " --quiet --seed 3"),
@@ -63,7 +59,8 @@ TEST(RenderCli, WritesExrWithHeaderAndPreview) {
 }
 
 TEST(RenderCli, FailedRunKeepsTheExistingOutput) {
-  const fs::path dir = fresh_dir("keep");
+  const test::ScratchDir scratch("render_cli_keep");
+  const fs::path& dir = scratch.path;
   write_scene(dir / "s.json", 8, 1);
   std::ofstream(dir / "out.exr") << "precious";
   EXPECT_EQ(run("render " + (dir / "s.json").string() + " -o " + (dir / "out.exr").string() +
@@ -84,7 +81,8 @@ TEST(RenderCli, FailedRunKeepsTheExistingOutput) {
 }
 
 TEST(RenderCli, SigintWritesAFlaggedPartialImage) {
-  const fs::path dir = fresh_dir("sigint");
+  const test::ScratchDir scratch("render_cli_sigint");
+  const fs::path& dir = scratch.path;
   write_scene(dir / "s.json", 256, 4096);  // minutes of work: it will be interrupted
   std::ofstream(dir / "out.exr") << "precious";
   const pid_t pid = fork();

@@ -15,6 +15,7 @@
 #include "nimbus/compare.h"
 #include "nimbus/error.h"
 #include "nimbus/image.h"
+#include "support/scratch_dir.h"
 
 #include <nlohmann/json.hpp>
 
@@ -23,12 +24,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-fs::path fresh_dir(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("nimbus_image_test_" + name);
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
 
 Image ramp(int w, int h) {
   Image img(w, h);
@@ -43,7 +38,8 @@ Image ramp(int w, int h) {
 }
 
 TEST(Image, ExrRoundTripIsExactWithMetadata) {
-  const fs::path f = fresh_dir("exr") / "a.exr";
+  const test::ScratchDir scratch("image_exr");
+  const fs::path f = scratch.path / "a.exr";
   const Image img = ramp(13, 7);
   write_exr(f, img, {{"nimbus/scene", "{\"x\": 1}"}, {"nimbus/partial", "false"}});
   ImageMetadata meta;
@@ -65,7 +61,8 @@ TEST(Image, SrgbEncoding) {
 }
 
 TEST(Image, PngHoldsSrgbBytesAndExposure) {
-  const fs::path dir = fresh_dir("png");
+  const test::ScratchDir scratch("image_png");
+  const fs::path& dir = scratch.path;
   Image img(4, 1);
   const float values[4] = {0.0f, 0.5f, 0.25f, 2.0f};
   for (int x = 0; x < 4; ++x) img.pixel(x, 0)[0] = img.pixel(x, 0)[1] = img.pixel(x, 0)[2] = values[x];
@@ -84,7 +81,8 @@ TEST(Image, PngHoldsSrgbBytesAndExposure) {
 }
 
 TEST(Image, FailedWritesKeepTheOldFileAndLeaveNoTemporaries) {
-  const fs::path dir = fresh_dir("atomic");
+  const test::ScratchDir scratch("image_atomic");
+  const fs::path& dir = scratch.path;
   const fs::path f = dir / "keep.exr";
   write_exr(f, ramp(5, 5));
   const auto before = fs::file_size(f);
@@ -110,14 +108,16 @@ TEST(Image, FailedWritesKeepTheOldFileAndLeaveNoTemporaries) {
 
 TEST(Image, UnwritableDirectoryIsReported) {
   if (geteuid() == 0) GTEST_SKIP() << "root writes anywhere";
-  const fs::path dir = fresh_dir("readonly");
+  const test::ScratchDir scratch("image_readonly");
+  const fs::path& dir = scratch.path;
   chmod(dir.c_str(), 0555);
   EXPECT_THROW(write_exr(dir / "x.exr", ramp(2, 2)), Error);
   chmod(dir.c_str(), 0755);
 }
 
 TEST(Image, ReadErrorsNameTheFile) {
-  const fs::path dir = fresh_dir("read");
+  const test::ScratchDir scratch("image_read");
+  const fs::path& dir = scratch.path;
   std::ofstream(dir / "junk.exr") << "this is not an EXR file";
   try {
     read_exr(dir / "junk.exr");
@@ -178,7 +178,8 @@ TEST(Compare, HeatmapColours) {
 }
 
 TEST(CompareCli, PrintsJsonAndNamesMissingFiles) {
-  const fs::path dir = fresh_dir("cli");
+  const test::ScratchDir scratch("image_cli");
+  const fs::path& dir = scratch.path;
   Image b(4, 4), a(4, 4);
   for (size_t i = 0; i < b.rgb.size(); ++i) {
     b.rgb[i] = 2.0f;

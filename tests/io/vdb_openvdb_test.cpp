@@ -24,15 +24,6 @@ void init() {
   (void)done;
 }
 
-std::string load_error(const std::filesystem::path& file, const std::string& grid = "") {
-  try {
-    DensityGrid::load(file, grid);
-  } catch (const Error& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "no error loading " << file;
-  return "";
-}
 
 void write_vdb(const std::filesystem::path& file, const openvdb::GridPtrVec& grids) {
   openvdb::io::File f(file.string());
@@ -147,14 +138,14 @@ TEST(VdbOpenVdb, GridSelectionAndTypeErrors) {
   write_vdb(dir / "multi.vdb", {vel, density, temp});
   EXPECT_EQ(DensityGrid::load(dir / "multi.vdb").stats().name, "density");  // first float grid
   EXPECT_EQ(DensityGrid::load(dir / "multi.vdb", "temperature").stats().max_value, 300.0);
-  std::string msg = load_error(dir / "multi.vdb", "smoke");
+  std::string msg = test::load_error(dir / "multi.vdb", "smoke");
   EXPECT_NE(msg.find("multi.vdb: no grid named \"smoke\""), std::string::npos) << msg;
   EXPECT_NE(msg.find("\"vel\" (vec3s)"), std::string::npos) << msg;
   EXPECT_NE(msg.find("\"density\" (float)"), std::string::npos) << msg;
-  msg = load_error(dir / "multi.vdb", "vel");
+  msg = test::load_error(dir / "multi.vdb", "vel");
   EXPECT_NE(msg.find("vec3s, not float"), std::string::npos) << msg;
   write_vdb(dir / "vec.vdb", {vel});
-  msg = load_error(dir / "vec.vdb");
+  msg = test::load_error(dir / "vec.vdb");
   EXPECT_NE(msg.find("vec.vdb: no float grid"), std::string::npos) << msg;
   EXPECT_EQ(inspect_volume_file(dir / "multi.vdb").size(), 3u);
   // The same through NanoVDB files.
@@ -163,9 +154,9 @@ TEST(VdbOpenVdb, GridSelectionAndTypeErrors) {
   handles.push_back(nanovdb::openToNanoVDB(*temp));
   nanovdb::io::writeGrids(dir / "multi.nvdb", handles, nanovdb::io::Codec::BLOSC);
   EXPECT_EQ(DensityGrid::load(dir / "multi.nvdb").stats().name, "temperature");
-  msg = load_error(dir / "multi.nvdb", "smoke");
+  msg = test::load_error(dir / "multi.nvdb", "smoke");
   EXPECT_NE(msg.find("\"vel\" (Vec3f)"), std::string::npos) << msg;
-  msg = load_error(dir / "multi.nvdb", "vel");
+  msg = test::load_error(dir / "multi.nvdb", "vel");
   EXPECT_NE(msg.find("not float"), std::string::npos) << msg;
   const auto infos = inspect_volume_file(dir / "multi.nvdb");
   ASSERT_EQ(infos.size(), 2u);
@@ -179,11 +170,11 @@ TEST(VdbOpenVdb, NaNIsAnErrorNegativeIsClampedAndCounted) {
   auto nan_grid = synthetic_grid();
   for (int i = 0; i < 3; ++i) nan_grid->tree().setValueOn(openvdb::Coord(i, 1, 1), std::nanf(""));
   write_vdb(dir / "nan.vdb", {nan_grid});
-  std::string msg = load_error(dir / "nan.vdb");
+  std::string msg = test::load_error(dir / "nan.vdb");
   EXPECT_NE(msg.find("nan.vdb: 3 NaN/inf density values (first at index [0, 1, 1]"), std::string::npos)
       << msg;
   nanovdb::io::writeGrid((dir / "inf.nvdb").string(), nanovdb::openToNanoVDB(*nan_grid));
-  EXPECT_NE(load_error(dir / "inf.nvdb").find("3 NaN/inf"), std::string::npos);
+  EXPECT_NE(test::load_error(dir / "inf.nvdb").find("3 NaN/inf"), std::string::npos);
 
   auto neg = synthetic_grid();
   for (int i = 0; i < 5; ++i) neg->tree().setValueOn(openvdb::Coord(i, 4, 0), -1.0f);
@@ -201,16 +192,16 @@ TEST(VdbOpenVdb, EmptyAndEnormousGridsAreRefused) {
   auto empty = openvdb::FloatGrid::create();
   empty->setName("density");
   write_vdb(dir / "empty.vdb", {empty});
-  EXPECT_NE(load_error(dir / "empty.vdb").find("empty"), std::string::npos);
+  EXPECT_NE(test::load_error(dir / "empty.vdb").find("empty"), std::string::npos);
   auto huge = openvdb::FloatGrid::create();
   huge->setName("density");
   huge->tree().setValueOn(openvdb::Coord(-2000, -2000, -2000), 1.0f);
   huge->tree().setValueOn(openvdb::Coord(2000, 2000, 2000), 1.0f);
   write_vdb(dir / "huge.vdb", {huge});
-  EXPECT_NE(load_error(dir / "huge.vdb").find("too large"), std::string::npos);
+  EXPECT_NE(test::load_error(dir / "huge.vdb").find("too large"), std::string::npos);
   nanovdb::io::writeGrid((dir / "huge.nvdb").string(), nanovdb::openToNanoVDB(*huge),
                          nanovdb::io::Codec::ZIP);
-  EXPECT_NE(load_error(dir / "huge.nvdb").find("too large"), std::string::npos);
+  EXPECT_NE(test::load_error(dir / "huge.nvdb").find("too large"), std::string::npos);
 }
 
 // Headers that lie about sizes: errors before any allocation, for every codec.
@@ -227,7 +218,7 @@ TEST(VdbOpenVdb, NanoVdbHeadersClaimingATerabyte) {
       const uint64_t tb = uint64_t(1) << 40;
       std::memcpy(b.data() + 16 + field, &tb, 8);
       test::write_bytes(file, b);
-      const std::string msg = load_error(file);
+      const std::string msg = test::load_error(file);
       EXPECT_NE(msg.find("lie.nvdb: "), std::string::npos) << msg;
     }
     // Bit flips all over a small file of each codec.

@@ -31,16 +31,6 @@ const DensityGrid& cached(const char* name) {
   return it->second;
 }
 
-// Loads `file` expecting a nimbus::Error; returns its message.
-std::string load_error(const std::filesystem::path& file, const std::string& grid = "") {
-  try {
-    DensityGrid::load(file, grid);
-  } catch (const Error& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "no error loading " << file;
-  return "";
-}
 
 TEST(VdbLoad, CloudMatchesSources) {
   NIMBUS_REQUIRE_FILE(shared_volume(kCloud));
@@ -226,16 +216,16 @@ INSTANTIATE_TEST_SUITE_P(SharedFiles, VdbSample, ::testing::Values(kCloud, kSmok
 
 TEST(VdbErrors, MissingEmptyDirectoryAndText) {
   test::ScratchDir dir("vdb_err");
-  EXPECT_NE(load_error(dir / "nope.vdb").find("nope.vdb: no such file"), std::string::npos);
+  EXPECT_NE(test::load_error(dir / "nope.vdb").find("nope.vdb: no such file"), std::string::npos);
   test::write_bytes(dir / "empty.vdb", {});
-  EXPECT_NE(load_error(dir / "empty.vdb").find("empty.vdb: empty file"), std::string::npos);
+  EXPECT_NE(test::load_error(dir / "empty.vdb").find("empty.vdb: empty file"), std::string::npos);
   std::filesystem::create_directories(dir / "dir.vdb");
-  EXPECT_NE(load_error(dir / "dir.vdb").find("directory"), std::string::npos);
+  EXPECT_NE(test::load_error(dir / "dir.vdb").find("directory"), std::string::npos);
   const std::string text = "# not a volume\nhello world\n";
   test::write_bytes(dir / "text.vdb", std::vector<char>(text.begin(), text.end()));
-  EXPECT_NE(load_error(dir / "text.vdb").find("text.vdb: not a VDB or NanoVDB file"), std::string::npos);
+  EXPECT_NE(test::load_error(dir / "text.vdb").find("text.vdb: not a VDB or NanoVDB file"), std::string::npos);
   test::write_bytes(dir / "text.nvdb", std::vector<char>(text.begin(), text.end()));
-  EXPECT_NE(load_error(dir / "text.nvdb").find("not a VDB or NanoVDB file"), std::string::npos);
+  EXPECT_NE(test::load_error(dir / "text.nvdb").find("not a VDB or NanoVDB file"), std::string::npos);
   EXPECT_THROW(inspect_volume_file(dir / "text.vdb"), Error);
 }
 
@@ -251,7 +241,7 @@ TEST_P(VdbCorrupt, TruncatedFilesGiveErrors) {
                    size_t(200), size_t(1000), size_t(5000), bytes.size() / 3, bytes.size() / 2,
                    bytes.size() - 100, bytes.size() - 1}) {
     test::write_bytes(file, bytes, n);
-    const std::string msg = load_error(file);
+    const std::string msg = test::load_error(file);
     EXPECT_NE(msg.find(file.string() + ": "), std::string::npos) << n << ": " << msg;
     EXPECT_THROW(inspect_volume_file(file), Error) << n;
   }

@@ -10,6 +10,10 @@
 #include <string>
 #include <vector>
 
+#include "io/vdb.h"
+#include "nimbus/error.h"
+#include "support/scratch_dir.h"
+
 namespace nimbus::test {
 
 inline std::filesystem::path shared_volume(const char* name) {
@@ -18,25 +22,6 @@ inline std::filesystem::path shared_volume(const char* name) {
 inline const char* kCloud = "wdas_cloud_sixteenth.vdb";
 inline const char* kSmoke = "openvdb_fvdb_smoke-blosc.nvdb";
 
-// A fresh directory under the system temp dir, removed when the object dies.
-struct ScratchDir {
-  std::filesystem::path path;
-  explicit ScratchDir(const std::string& tag) {
-    path = std::filesystem::temp_directory_path() /
-           ("nimbus_" + tag + "_" + std::to_string(::getpid()) + "_" + std::to_string(counter()++));
-    std::filesystem::remove_all(path);
-    std::filesystem::create_directories(path);
-  }
-  ~ScratchDir() {
-    std::error_code ec;
-    std::filesystem::remove_all(path, ec);
-  }
-  std::filesystem::path operator/(const std::string& name) const { return path / name; }
-  static int& counter() {
-    static int n = 0;
-    return n;
-  }
-};
 
 inline std::vector<char> read_bytes(const std::filesystem::path& file) {
   std::ifstream is(file, std::ios::binary);
@@ -47,6 +32,17 @@ inline void write_bytes(const std::filesystem::path& file, const std::vector<cha
                         size_t n = size_t(-1)) {
   std::ofstream os(file, std::ios::binary | std::ios::trunc);
   os.write(bytes.data(), static_cast<std::streamsize>(std::min(n, bytes.size())));
+}
+
+// Loads `file` expecting a nimbus::Error; returns its message.
+inline std::string load_error(const std::filesystem::path& file, const std::string& grid = "") {
+  try {
+    DensityGrid::load(file, grid);
+  } catch (const Error& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no error loading " << file;
+  return "";
 }
 
 }  // namespace nimbus::test
