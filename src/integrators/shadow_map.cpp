@@ -6,21 +6,30 @@
 
 namespace nimbus {
 
+Rgb reduced_sigma_t(const SceneMedia& media, const Vec3& p, const std::vector<double>& peak_fraction) {
+  if (peak_fraction.empty()) return media.sigma_t(p);
+  MediumPoint mp;
+  media.eval(p, &mp);
+  Rgb s = mp.sigma_t();
+  for (int i = 0; i < mp.count && i < int(peak_fraction.size()); ++i) s -= mp.sigma_s_i[i] * peak_fraction[i];
+  return s;
+}
+
 Rgb marched_transmittance(const SceneMedia& media, const MajorantGrid& grid, const Vec3& p, const Vec3& w,
-                          double tmax, double tau_step) {
+                          double tmax, double tau_step, const std::vector<double>& peak_fraction) {
   Rgb tau(0.0);
   grid.traverse(p, w, 0.0, tmax, [&](double t0, double t1, double maj) {
     if (maj <= 0.0) return true;
     const int n = std::max(1, int(std::ceil((t1 - t0) * maj / tau_step)));
     const double dt = (t1 - t0) / n;
-    for (int k = 0; k < n; ++k) tau += media.sigma_t(p + w * (t0 + (k + 0.5) * dt)) * dt;
+    for (int k = 0; k < n; ++k) tau += reduced_sigma_t(media, p + w * (t0 + (k + 0.5) * dt), peak_fraction) * dt;
     return min_component(tau) < 50.0;
   });
   return exp(-tau);
 }
 
 TransmittanceGrid::TransmittanceGrid(const SceneMedia& media, const MajorantGrid& grid, const Light& light,
-                                     int resolution, double tau_step) {
+                                     int resolution, double tau_step, const std::vector<double>& peak_fraction) {
   bounds_ = grid.bounds();
   if (bounds_.empty()) {
     bounds_.lo = Vec3(0.0);
@@ -41,9 +50,10 @@ TransmittanceGrid::TransmittanceGrid(const SceneMedia& media, const MajorantGrid
         Rgb T(1.0);
         // The centre of the light (a sun disc is treated as its centre direction here).
         if (const auto* d = std::get_if<DirectionalLight>(&light)) {
-          T = marched_transmittance(media, grid, p, -d->direction, std::numeric_limits<double>::infinity(), tau_step);
+          T = marched_transmittance(media, grid, p, -d->direction, std::numeric_limits<double>::infinity(), tau_step,
+                                    peak_fraction);
         } else if (sample_light(light, p, 0.5, 0.5, &ls)) {
-          T = marched_transmittance(media, grid, p, ls.wi, ls.distance, tau_step);
+          T = marched_transmittance(media, grid, p, ls.wi, ls.distance, tau_step, peak_fraction);
         }
         float* v = &values_[((size_t(z) * nodes_[1] + y) * nodes_[0] + x) * 3];
         for (int c = 0; c < 3; ++c) v[c] = float(T[c]);

@@ -12,16 +12,23 @@
 
 namespace nimbus {
 
+// Extinction at p with a fraction of each medium's scattering removed: sigma_t - sum_i
+// peak_fraction[i] sigma_s_i (the forward peak of medium i's
+// phase function is not extinction for forward-scattered light; `mfs`). Empty: plain sigma_t.
+Rgb reduced_sigma_t(const SceneMedia& media, const Vec3& p, const std::vector<double>& peak_fraction);
+
 // Transmittance from p along w over [0, tmax] by a midpoint march with steps of at most tau_step
-// optical depth against the majorant (deterministic; error O(step^2) for smooth media).
+// optical depth against the majorant (deterministic; error O(step^2) for smooth media). With
+// peak_fraction the extinction is reduced_sigma_t.
 Rgb marched_transmittance(const SceneMedia& media, const MajorantGrid& grid, const Vec3& p, const Vec3& w,
-                          double tmax, double tau_step);
+                          double tmax, double tau_step, const std::vector<double>& peak_fraction = {});
 
 class TransmittanceGrid {
  public:
   // resolution: nodes along the longest axis of the media's bounds.
+  // peak_fraction: see reduced_sigma_t (empty: plain extinction).
   TransmittanceGrid(const SceneMedia& media, const MajorantGrid& grid, const Light& light, int resolution,
-                    double tau_step);
+                    double tau_step, const std::vector<double>& peak_fraction = {});
   Rgb lookup(const Vec3& p) const;
   size_t memory_bytes() const { return values_.size() * sizeof(float); }
 

@@ -15,7 +15,7 @@
 
 namespace nimbus {
 
-std::vector<std::string> integrator_names() { return {"pathtrace", "single"}; }
+std::vector<std::string> integrator_names() { return {"pathtrace", "single", "mfs", "octave"}; }
 
 RenderResult render(const Scene& scene, const RenderOptions& options) {
   const auto start = std::chrono::steady_clock::now();

@@ -1,0 +1,160 @@
+#include "transport/phase_split.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <tbb/parallel_for.h>
+
+#include "core/math.h"
+#include "nimbus/error.h"
+#include "transport/small_angle.h"
+
+namespace nimbus {
+
+namespace {
+
+constexpr int kAngleNodes = 512;  // theta = pi u^2, u uniform: dense near the forward peak
+constexpr int kTauNodes = 48;     // tau = kTauMax v^2, v uniform
+constexpr int kMomentCap = 2000;
+
+// Peak mass above the level P(theta_c) inside theta < theta_c (midpoint rule in theta).
+double clipped_mass(const Phase& phase, double theta_c) {
+  if (theta_c <= 0.0) return 0.0;
+  const double level = phase_eval(phase, std::cos(theta_c));
+  const int n = 4000;
+  const double h = theta_c / n;
+  double m = 0.0;
+  for (int i = 0; i < n; ++i) {
+    const double th = (i + 0.5) * h;
+    m += std::max(0.0, phase_eval(phase, std::cos(th)) - level) * std::sin(th);
+  }
+  return 2.0 * kPi * h * m;
+}
+
+}  // namespace
+
+double auto_peak_fraction(const Phase& phase) {
+  const double g = phase_mean_cosine(phase);
+  return g > 0.0 ? g * g : 0.0;
+}
+
+PhaseSplit::PhaseSplit(const Phase& phase, double peak_fraction, bool gaussian) : phase_(phase) {
+  if (!(peak_fraction >= 0.0 && peak_fraction <= 0.999))
+    throw Error("phase split: peak fraction must be in [0, 0.999]");
+  const std::vector<double> chi = phase_legendre_moments(phase, 1e-8, kMomentCap);
+
+  // Cut angle for the requested fraction (clipped mass grows with theta_c for a forward-peaked P).
+  level_ = std::numeric_limits<double>::infinity();
+  if (peak_fraction > 1e-6) {
+    double lo = 0.0, hi = kPi;
+    const double reachable = clipped_mass(phase, hi);
+    if (peak_fraction >= reachable) {
+      theta_c_ = hi;
+    } else {
+      for (int it = 0; it < 60; ++it) {
+        const double mid = 0.5 * (lo + hi);
+        (clipped_mass(phase, mid) < peak_fraction ? lo : hi) = mid;
+      }
+      theta_c_ = hi;
+    }
+    f_ = clipped_mass(phase, theta_c_);
+    level_ = phase_eval(phase, std::cos(theta_c_));
+  }
+
+  // Moments of the wide part (tabulated finely, the cut angle a node) and of the peak by difference.
+  if (f_ > 0.0) {
+    std::vector<double> theta, value;
+    const int n = 4000;
+    for (int i = 0; i < n; ++i) {
+      const double u = double(i) / (n - 1), th = kPi * u * u;
+      if (!theta.empty() && theta.back() < theta_c_ && th > theta_c_) {
+        theta.push_back(theta_c_);
+        value.push_back(level_);
+      }
+      if (th == theta_c_ && !theta.empty() && theta.back() == th) continue;
+      theta.push_back(th);
+      value.push_back(th < theta_c_ ? std::min(phase_eval(phase, std::cos(th)), level_) : phase_eval(phase, std::cos(th)));
+    }
+    chi_wide_ = phase_legendre_moments(make_tabulated_phase("mfs-wide", theta, value), 1e-8, kMomentCap);
+  } else {
+    chi_wide_ = chi;
+  }
+  const size_t L = std::max(chi.size(), chi_wide_.size());
+  std::vector<double> chi_full = chi;
+  chi_full.resize(L, 0.0);
+  chi_wide_.resize(L, 0.0);
+  chi_peak_.assign(L, 1.0);  // no peak: a delta (tau_p stays 0 anyway)
+  if (f_ > 0.0) {
+    for (size_t l = 0; l < L; ++l) chi_peak_[l] = (chi_full[l] - (1.0 - f_) * chi_wide_[l]) / f_;
+    if (gaussian) {
+      const double theta2 = L > 2 ? (1.0 - chi_peak_[2]) / 3.0 : 0.0;
+      for (size_t l = 0; l < L; ++l) chi_peak_[l] = std::exp(-0.5 * theta2 * double(l) * double(l + 1));
+    }
+  }
+
+  // Tables: the unscattered term pointwise plus the scattered Legendre series.
+  std::vector<double> tau(kTauNodes), e_tau(kTauNodes);
+  std::vector<double> E(size_t(kTauNodes) * L);  // exp(-tau (1 - chi_peak_l)) - exp(-tau)
+  for (int k = 0; k < kTauNodes; ++k) {
+    const double v = double(k) / (kTauNodes - 1);
+    tau[k] = kTauMax * v * v;
+    e_tau[k] = std::exp(-tau[k]);
+    for (size_t l = 0; l < L; ++l)
+      E[k * L + l] = std::exp(-tau[k] * (1.0 - chi_peak_[l])) - e_tau[k];
+  }
+  wide_table_.assign(size_t(kTauNodes) * kAngleNodes, 0.0f);
+  peak_table_.assign(size_t(kTauNodes) * kAngleNodes, 0.0f);
+  tbb::parallel_for(0, kAngleNodes, [&](int j) {
+    const double u = double(j) / (kAngleNodes - 1), mu = std::cos(kPi * u * u);
+    std::vector<double> cw(L), cp(L);  // (2l+1)/(4 pi) chi_l P_l(mu)
+    double p0 = 1.0, p1 = mu;
+    for (size_t l = 0; l < L; ++l) {
+      const double pl = l == 0 ? 1.0 : p1;
+      const double c = (2.0 * l + 1.0) / (4.0 * kPi) * pl;
+      cw[l] = c * chi_wide_[l];
+      cp[l] = c * chi_peak_[l];
+      if (l >= 1) {
+        const double p2 = ((2.0 * l + 1.0) * mu * p1 - l * p0) / (l + 1.0);
+        p0 = p1;
+        p1 = p2;
+      }
+    }
+    const double w0 = wide(mu), q0 = peak(mu);
+    for (int k = 0; k < kTauNodes; ++k) {
+      double sw = 0.0, sp = 0.0;
+      for (size_t l = 0; l < L; ++l) {
+        sw += cw[l] * E[k * L + l];
+        sp += cp[l] * E[k * L + l];
+      }
+      wide_table_[size_t(k) * kAngleNodes + j] = float(std::max(0.0, e_tau[k] * w0 + sw));
+      peak_table_[size_t(k) * kAngleNodes + j] = float(std::max(0.0, e_tau[k] * q0 + sp));
+    }
+  });
+}
+
+double PhaseSplit::wide(double cos_theta) const {
+  const double p = phase_eval(phase_, cos_theta);
+  if (f_ <= 0.0) return p;
+  const double th = std::acos(std::clamp(cos_theta, -1.0, 1.0));
+  return (th < theta_c_ ? std::min(p, level_) : p) / (1.0 - f_);
+}
+
+double PhaseSplit::peak(double cos_theta) const {
+  if (f_ <= 0.0) return 0.0;
+  const double th = std::acos(std::clamp(cos_theta, -1.0, 1.0));
+  if (th >= theta_c_) return 0.0;
+  return std::max(0.0, phase_eval(phase_, cos_theta) - level_) / f_;
+}
+
+double PhaseSplit::lookup(const std::vector<float>& table, double tau_p, double cos_theta) const {
+  const double th = std::acos(std::clamp(cos_theta, -1.0, 1.0));
+  const double a = std::sqrt(th / kPi) * (kAngleNodes - 1);
+  const double t = std::sqrt(std::clamp(tau_p, 0.0, kTauMax) / kTauMax) * (kTauNodes - 1);
+  const int j = std::min(int(a), kAngleNodes - 2), k = std::min(int(t), kTauNodes - 2);
+  const double fa = a - j, ft = t - k;
+  const float* r0 = &table[size_t(k) * kAngleNodes + j];
+  const float* r1 = r0 + kAngleNodes;
+  return (1 - ft) * ((1 - fa) * r0[0] + fa * r0[1]) + ft * ((1 - fa) * r1[0] + fa * r1[1]);
+}
+
+}  // namespace nimbus

@@ -1,0 +1,59 @@
+// The forward-peak / wide split of a phase function and the angular weights `mfs` needs (pure math).
+//
+// The phase function is split pointwise at a cut angle theta_c:
+//     P = f P_peak + (1 - f) P_wide,
+//     (1 - f) P_wide(theta) = min(P(theta), P(theta_c))  for theta < theta_c,  P(theta) beyond,
+// so both parts are non-negative and normalised; the peak lives inside theta < theta_c.  f (the peak
+// fraction) picks theta_c.  Peak scatters are carried by the small-angle propagator (they deflect light
+// by little and are NOT extinction for the forward-carried light); wide scatters are discrete events
+// (similarity / delta-M idea with a peak of finite width instead of a delta).
+//
+// After a path with peak optical depth tau_p (= f tau_s along it), light that left a scatter with the
+// angular distribution Q has the distribution (Funk-Hecke: convolution multiplies Legendre moments)
+//     Q_eff(tau_p, mu) = sum_l (2l + 1)/(4 pi) q_l exp(-tau_p (1 - chi_l^peak)) P_l(mu)
+// (the generalised small-angle propagator of transport/small_angle.h for the peak, unscattered part
+// included), whose integral over the sphere is 1 for every tau_p.  The tables hold Q_eff for
+// Q = P_wide and Q = P_peak, the unscattered term exp(-tau_p) Q(mu) pointwise (no Gibbs ringing) plus
+// the scattered series.
+#pragma once
+
+#include <vector>
+
+#include "media/phase.h"
+
+namespace nimbus {
+
+// f = g^2 for mean cosine g > 0 (the delta-Eddington fraction), 0 otherwise.
+double auto_peak_fraction(const Phase& phase);
+
+class PhaseSplit {
+ public:
+  // peak_fraction in [0, 0.999]: the part of the scattering carried forward by the propagator.
+  // gaussian: replace the peak's moments by a Gaussian stand-in with the same theta2 (the closed form's
+  // assumption) instead of its own (the generalised propagator).
+  PhaseSplit(const Phase& phase, double peak_fraction, bool gaussian = false);
+
+  double f() const { return f_; }             // achieved peak fraction
+  double cut_angle() const { return theta_c_; }  // theta_c [rad]
+  // Normalised parts, per sr, at cos_theta between propagation directions.
+  double wide(double cos_theta) const;
+  double peak(double cos_theta) const;
+  // Propagated parts (see above), per sr; tau_p >= 0 (clamped to the table's range).
+  double wide_eff(double tau_p, double cos_theta) const { return lookup(wide_table_, tau_p, cos_theta); }
+  double peak_eff(double tau_p, double cos_theta) const { return lookup(peak_table_, tau_p, cos_theta); }
+
+  const std::vector<double>& peak_moments() const { return chi_peak_; }
+  const std::vector<double>& wide_moments() const { return chi_wide_; }
+
+  static constexpr double kTauMax = 64.0;
+
+ private:
+  double lookup(const std::vector<float>& table, double tau_p, double cos_theta) const;
+
+  Phase phase_;
+  double f_ = 0.0, theta_c_ = 0.0, level_ = 0.0;  // level_ = P(theta_c)
+  std::vector<double> chi_peak_, chi_wide_;
+  std::vector<float> wide_table_, peak_table_;  // [tau node][angle node]
+};
+
+}  // namespace nimbus
