@@ -41,7 +41,7 @@ std::unique_ptr<Integrator> make_integrator(const std::string& type, const Integ
                                             const SceneContext& context) {
   if (type == "pathtrace") return std::make_unique<PathTracer>(context, settings.max_events);
   if (type == "single") return std::make_unique<SingleScatter>(context, parse_single_settings(settings.options, "scene", false));
-  if (type == "mfs") return std::make_unique<MfsIntegrator>(context, parse_mfs_settings(settings.options, "scene", false));
+  if (type == "mfs") return std::make_unique<MfsIntegrator>(context, parse_mfs_settings(settings.options, "scene", false, settings.seed));
   if (type == "octave")
     return std::make_unique<OctaveIntegrator>(context, parse_octave_settings(settings.options, "scene", false));
   throw Error(fmt::format("unknown integrator '{}' (known: {})", type, fmt::join(integrator_names(), ", ")));

@@ -8,8 +8,10 @@
 
 namespace nimbus {
 
-MfsSettings parse_mfs_settings(const nlohmann::json& options, const std::string& where, bool strict) {
+MfsSettings parse_mfs_settings(const nlohmann::json& options, const std::string& where, bool strict,
+                               uint64_t seed) {
   MfsSettings s;
+  s.grid.seed = seed;
   JsonObject o(options, where, "/integrator");
   s.tau_step = o.number("tau_step", 1e-4, 100.0, s.tau_step);
   const std::string light_path = o.string("light_path", "forward");
@@ -17,21 +19,31 @@ MfsSettings parse_mfs_settings(const nlohmann::json& options, const std::string&
     o.fail("light_path", "must be \"forward\" or \"beer_lambert\"");
   s.forward_light_path = light_path == "forward";
   const std::string propagator = o.string("propagator", "gsa");
-  if (propagator != "gsa" && propagator != "gaussian") o.fail("propagator", "must be \"gsa\" or \"gaussian\"");
+  if (propagator != "gsa" && propagator != "gaussian")
+    o.fail("propagator", "must be \"gsa\" or \"gaussian\"");
   s.gaussian = propagator == "gaussian";
   if (o.has("peak_fraction") && o.raw("peak_fraction").is_string()) {
-    if (o.string("peak_fraction") != "auto") o.fail("peak_fraction", "must be \"auto\" or a number in [0, 0.99]");
+    if (o.string("peak_fraction") != "auto")
+      o.fail("peak_fraction", "must be \"auto\" or a number in [0, 0.99]");
   } else {
     s.peak_fraction = o.number("peak_fraction", 0.0, 0.99, s.peak_fraction < 0 ? -1.0 : s.peak_fraction);
   }
-  s.large_angle_scatters = int(o.integer("large_angle_scatters", 1, 16, s.large_angle_scatters));
-  if (s.large_angle_scatters != 1) o.fail("large_angle_scatters", "only 1 is implemented so far");
+  if (o.has("large_angle_scatters") && o.raw("large_angle_scatters").is_string()) {
+    if (o.string("large_angle_scatters") != "all")
+      o.fail("large_angle_scatters", "must be \"all\" or an integer in [1, 1024]");
+  } else {
+    s.large_angle_scatters = int(o.integer("large_angle_scatters", 1, 1024, 0));
+  }
+  s.grid.max_wide_scatters = s.large_angle_scatters;
+  s.grid.photons = int(o.integer("photons", 1, 1 << 26, s.grid.photons));
+  s.grid.resolution = int(o.integer("scatter_grid_resolution", 4, 96, s.grid.resolution));
   s.shadow_map_resolution = int(o.integer("shadow_map_resolution", 8, 1024, s.shadow_map_resolution));
   if (strict) o.finish();
   return s;
 }
 
-MfsIntegrator::MfsIntegrator(const SceneContext& context, MfsSettings settings) : ctx_(context), s_(settings) {
+MfsIntegrator::MfsIntegrator(const SceneContext& context, MfsSettings settings)
+    : ctx_(context), s_(settings) {
   for (int i = 0; i < ctx_.media.count(); ++i) {
     const Phase& phase = ctx_.media.phase(i);
     const double f = s_.peak_fraction < 0.0 ? std::min(0.99, auto_peak_fraction(phase)) : s_.peak_fraction;
@@ -40,29 +52,14 @@ MfsIntegrator::MfsIntegrator(const SceneContext& context, MfsSettings settings) 
   }
   for (const Light& l : ctx_.lights) {
     full_maps_.emplace_back(ctx_.media, ctx_.majorants, l, s_.shadow_map_resolution, 0.05);
-    if (s_.forward_light_path) reduced_maps_.emplace_back(ctx_.media, ctx_.majorants, l, s_.shadow_map_resolution, 0.05, f_);
+    if (s_.forward_light_path)
+      reduced_maps_.emplace_back(ctx_.media, ctx_.majorants, l, s_.shadow_map_resolution, 0.05, f_);
   }
-}
-
-Rgb MfsIntegrator::reduced_ratio_transmittance(const Vec3& p, const Vec3& w, Rng& rng) const {
-  Rgb T(1.0);
-  track(ctx_.majorants, p, w, std::numeric_limits<double>::infinity(), rng, [&](const Vec3& x, double maj) {
-    T *= Rgb(1.0) - reduced_sigma_t(ctx_.media, x, f_) / maj;
-    const double m = max_component(T);
-    if (m <= 0.0) {
-      T = Rgb(0.0);
-      return false;
-    }
-    if (m < 0.1) {
-      if (rng.uniform() < 0.5) {
-        T = Rgb(0.0);
-        return false;
-      }
-      T *= 2.0;
-    }
-    return true;
-  });
-  return T;
+  if (s_.large_angle_scatters != 1) {
+    std::vector<const PhaseSplit*> splits;
+    for (const auto& sp : splits_) splits.push_back(sp.get());
+    grid_ = std::make_unique<ScatterGrid>(ctx_, splits, f_, s_.grid);
+  }
 }
 
 Rgb MfsIntegrator::sample(double px, double py, Rng& rng) const {
@@ -75,63 +72,74 @@ Rgb MfsIntegrator::radiance(const Vec3& o, const Vec3& d, Rng& rng) const {
   Rgb L(0.0), T_full(1.0), T_red(1.0), tau_p(0.0);
   const double jitter = rng.uniform();
   MediumPoint mp;
-  ctx_.majorants.traverse(o, d, 0.0, std::numeric_limits<double>::infinity(),
-                          [&](double t0, double t1, double maj) {
-    if (maj <= 0.0) return true;
-    const int n = std::max(1, int(std::ceil((t1 - t0) * maj / s_.tau_step)));
-    const double dt = (t1 - t0) / n;
-    for (int k = 0; k < n; ++k) {
-      const Vec3 p = o + d * (t0 + (k + jitter) * dt);
-      ctx_.media.eval(p, &mp);
-      Rgb sigma_peak(0.0);
-      for (int i = 0; i < mp.count; ++i) sigma_peak += mp.sigma_s_i[i] * f_[i];
-      const Rgb sigma_red = mp.sigma_t() - sigma_peak;
-      if (max_component(mp.sigma_s) > 0.0) {
-        // Camera-side depths at the sample point.
-        const Rgb T_here = T_red * exp(-sigma_red * (jitter * dt));
-        const Rgb tp = tau_p + sigma_peak * (jitter * dt);
-        Rgb in_scatter(0.0);
-        for (int i = 0; i < mp.count; ++i) {
-          if (max_component(mp.sigma_s_i[i]) <= 0.0) continue;
-          const PhaseSplit& split = *splits_[i];
-          const double f = f_[i];
-          Rgb Li(0.0);
-          // Directional and point lights: wide term and peak term.
-          for (size_t l = 0; l < ctx_.lights.size(); ++l) {
-            LightSample ls;
-            const double u1 = rng.uniform(), u2 = rng.uniform();
-            if (!sample_light(ctx_.lights[l], p, u1, u2, &ls)) continue;
-            const double mu = dot(d, ls.wi);
-            const Rgb T_light = full_maps_[l].lookup(p);
-            const Rgb T_wide = s_.forward_light_path ? reduced_maps_[l].lookup(p) : T_light;
-            for (int c = 0; c < 3; ++c)
-              Li[c] += ls.weight[c] * ((1.0 - f) * split.wide_eff(tp[c], mu) * T_wide[c] +
-                                       f * split.peak_eff(tp[c], mu) * T_light[c]);
-          }
-          // The environment through one phase-sampled direction (weight P_eff / P).
-          if (ctx_.has_environment) {
-            const double u1 = rng.uniform(), u2 = rng.uniform();
-            const Vec3 wi = phase_sample(ctx_.media.phase(i), d, u1, u2);
-            const double mu = dot(d, wi), pdf = phase_eval(ctx_.media.phase(i), mu);
-            if (pdf > 0.0) {
-              const Rgb T_light = ratio_tracking_transmittance(ctx_.media, ctx_.majorants, p, wi,
-                                                               std::numeric_limits<double>::infinity(), rng);
-              const Rgb T_wide = s_.forward_light_path ? reduced_ratio_transmittance(p, wi, rng) : T_light;
-              for (int c = 0; c < 3; ++c)
-                Li[c] += ctx_.environment[c] *
-                         ((1.0 - f) * split.wide_eff(tp[c], mu) * T_wide[c] + f * split.peak_eff(tp[c], mu) * T_light[c]) / pdf;
+  march(ctx_.majorants, o, d, std::numeric_limits<double>::infinity(), s_.tau_step, jitter,
+        [&](const Vec3& p, double, double dt) {
+          ctx_.media.eval(p, &mp);
+          Rgb sigma_peak(0.0);
+          for (int i = 0; i < mp.count; ++i) sigma_peak += mp.sigma_s_i[i] * f_[i];
+          const Rgb sigma_red = mp.sigma_t() - sigma_peak;
+          if (max_component(mp.sigma_s) > 0.0) {
+            // Camera-side depths at the sample point.
+            const Rgb T_here = T_red * exp(-sigma_red * (jitter * dt));
+            const Rgb tp = tau_p + sigma_peak * (jitter * dt);
+            Rgb in_scatter(0.0);
+            for (int i = 0; i < mp.count; ++i) {
+              if (max_component(mp.sigma_s_i[i]) <= 0.0) continue;
+              const PhaseSplit& split = *splits_[i];
+              const double f = f_[i];
+              Rgb Li(0.0);
+              // Directional and point lights: wide term and peak term.
+              for (size_t l = 0; l < ctx_.lights.size(); ++l) {
+                LightSample ls;
+                const double u1 = rng.uniform(), u2 = rng.uniform();
+                if (!sample_light(ctx_.lights[l], p, u1, u2, &ls)) continue;
+                const double mu = dot(d, ls.wi);
+                const Rgb T_light = full_maps_[l].lookup(p);
+                const Rgb T_wide = s_.forward_light_path ? reduced_maps_[l].lookup(p) : T_light;
+                for (int c = 0; c < 3; ++c)
+                  Li[c] += ls.weight[c] * ((1.0 - f) * split.wide_eff(tp[c], mu) * T_wide[c] +
+                                           f * split.peak_eff(tp[c], mu) * T_light[c]);
+              }
+              // The environment through one phase-sampled direction (weight P_eff / P).
+              if (ctx_.has_environment) {
+                const double u1 = rng.uniform(), u2 = rng.uniform();
+                const Vec3 wi = phase_sample(ctx_.media.phase(i), d, u1, u2);
+                const double mu = dot(d, wi), pdf = phase_eval(ctx_.media.phase(i), mu);
+                if (pdf > 0.0) {
+                  const Rgb T_light = ratio_tracking_transmittance(
+                      ctx_.media, ctx_.majorants, p, wi, std::numeric_limits<double>::infinity(), rng);
+                  const Rgb T_wide =
+                      s_.forward_light_path
+                          ? ratio_tracking(ctx_.majorants, p, wi, std::numeric_limits<double>::infinity(),
+                                           rng,
+                                           [&](const Vec3& x) { return reduced_sigma_t(ctx_.media, x, f_); })
+                          : T_light;
+                  for (int c = 0; c < 3; ++c)
+                    Li[c] += ctx_.environment[c] *
+                             ((1.0 - f) * split.wide_eff(tp[c], mu) * T_wide[c] +
+                              f * split.peak_eff(tp[c], mu) * T_light[c]) /
+                             pdf;
+                }
+              }
+              // Light that already took wide scatters: its last wide scatter is here.
+              if (grid_) {
+                const std::vector<double>& chi_w = split.wide_moments();
+                const std::vector<double>& chi_p = split.peak_moments();
+                const double g_wide = chi_w.size() > 1 ? chi_w[1] : 0.0;
+                const double blur = chi_p.size() > 1 ? 1.0 - chi_p[1] : 0.0;
+                Rgb g;
+                for (int c = 0; c < 3; ++c) g[c] = g_wide * std::exp(-tp[c] * blur);
+                Li += (1.0 - f) * grid_->scattered(p, -d, g);
+              }
+              in_scatter += mp.sigma_s_i[i] * Li;
             }
+            L += T_here * in_scatter * dt;
           }
-          in_scatter += mp.sigma_s_i[i] * Li;
-        }
-        L += T_here * in_scatter * dt;
-      }
-      T_full *= exp(-mp.sigma_t() * dt);
-      T_red *= exp(-sigma_red * dt);
-      tau_p += sigma_peak * dt;
-    }
-    return max_component(T_red) > 1e-6;
-  });
+          T_full *= exp(-mp.sigma_t() * dt);
+          T_red *= exp(-sigma_red * dt);
+          tau_p += sigma_peak * dt;
+          return max_component(T_red) > 1e-6;
+        });
   if (ctx_.has_environment) L += T_full * ctx_.environment;
   return L;
 }

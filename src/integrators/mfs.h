@@ -6,14 +6,19 @@
 // discrete events. Along the camera ray (march fixed in optical depth, jittered once per camera ray,
 // as `single`) a point y at camera-side peak depth tau_p and reduced optical depth
 // tau_r = int (sigma_a + (1 - f) sigma_s) receives light and sends towards the camera
-//     sigma_s E_light [ (1 - f) T_light'(y) P_wide_eff(tau_p, mu) + f T_light(y) P_peak_eff(tau_p, mu) ] exp(-tau_r)
+//     sigma_s E_light [ (1 - f) T_light'(y) P_wide_eff(tau_p, mu) + f T_light(y) P_peak_eff(tau_p, mu) ]
+//     exp(-tau_r)
 // with mu the cosine between the light's and the camera-bound propagation directions:
 //  - the wide term: the FIRST wide scatter of the path happens at y; light_path "forward" lets the light
 //    reach y through peak scatters only (T_light' with the reduced extinction, direction blur of the
 //    light side neglected), "beer_lambert" (paper-faithful) only unscattered (T_light = exp(-tau_t));
 //  - the peak term: paths with no wide scatter at all (the light seen through the forward peak: silver
 //    linings), first scatter at y, light unscattered before it.
-// Paths with two or more wide scatters are MISSING (large_angle_scatters > 1 is not implemented yet).
+// Paths with two or more wide scatters (large_angle_scatters K > 1, default all): the light that has
+// already scattered widely 1 .. K-1 times comes from a photon-traced fluence-and-flux grid
+// (integrators/scatter_grid.h) and takes its last wide scatter at y:
+//     sigma_s (1 - f) (phi + 3 g_wide_eff(tau_p) F . w_o) / (4 pi)
+// with g_wide_eff = g_wide exp(-tau_p (1 - chi_1^peak)) (the camera-side peak blur of its mean cosine).
 // Light transmittances come from deep shadow maps (deterministic). The environment is sampled through
 // the phase function with ratio tracking (reduced extinction for the wide part), as `single` does.
 // Every channel uses its own optical depths; overlapping media share one tau_p (sum of f_i sigma_s_i).
@@ -23,6 +28,7 @@
 #include <vector>
 
 #include "integrators/integrator.h"
+#include "integrators/scatter_grid.h"
 #include "integrators/shadow_map.h"
 #include "render/lights.h"
 #include "transport/phase_split.h"
@@ -30,15 +36,17 @@
 namespace nimbus {
 
 struct MfsSettings {
-  double tau_step = 0.1;         // optical depth per march step (against the majorant)
+  double tau_step = 0.1;           // optical depth per march step (against the majorant)
   bool forward_light_path = true;  // light_path: "forward" (true) or "beer_lambert"
-  bool gaussian = false;         // propagator: "gsa" (false) or "gaussian" (Gaussian stand-in for the peak)
-  double peak_fraction = -1.0;   // f in [0, 0.99]; < 0: "auto" (g^2 per medium)
-  int large_angle_scatters = 1;  // K (only 1 implemented)
+  bool gaussian = false;           // propagator: "gsa" (false) or "gaussian" (Gaussian stand-in for the peak)
+  double peak_fraction = -1.0;     // f in [0, 0.99]; < 0: "auto" (g^2 per medium)
+  int large_angle_scatters = 0;    // K: at most K wide scatters per path; 0 = "all"
   int shadow_map_resolution = 64;
+  ScatterGridSettings grid;  // the higher orders (K != 1): photons, resolution; seed from the scene
 };
 
-MfsSettings parse_mfs_settings(const nlohmann::json& options, const std::string& where, bool strict);
+MfsSettings parse_mfs_settings(const nlohmann::json& options, const std::string& where, bool strict,
+                               uint64_t seed = 1);
 
 class MfsIntegrator final : public Integrator {
  public:
@@ -46,15 +54,15 @@ class MfsIntegrator final : public Integrator {
   Rgb sample(double px, double py, Rng& rng) const override;
   Rgb radiance(const Vec3& o, const Vec3& d, Rng& rng) const;
   const PhaseSplit& split(int medium) const { return *splits_[medium]; }
+  const ScatterGrid* scatter_grid() const { return grid_.get(); }
 
  private:
-  Rgb reduced_ratio_transmittance(const Vec3& p, const Vec3& w, Rng& rng) const;
-
   const SceneContext& ctx_;
   MfsSettings s_;
-  std::vector<std::unique_ptr<PhaseSplit>> splits_;  // per medium
-  std::vector<double> f_;                           // per medium peak fraction
+  std::vector<std::unique_ptr<PhaseSplit>> splits_;          // per medium
+  std::vector<double> f_;                                    // per medium peak fraction
   std::vector<TransmittanceGrid> full_maps_, reduced_maps_;  // per light
+  std::unique_ptr<ScatterGrid> grid_;                        // wide scatters 2 .. K (null for K = 1)
 };
 
 }  // namespace nimbus

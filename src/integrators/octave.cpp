@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "integrators/tracking.h"
 #include "io/json_reader.h"
 #include "render/lights.h"
 
@@ -22,7 +23,8 @@ OctaveSettings parse_octave_settings(const nlohmann::json& options, const std::s
 
 Phase scale_phase_eccentricity(const Phase& phase, double scale) {
   if (const auto* hg = std::get_if<HgPhase>(&phase)) return HgPhase{hg->g * scale};
-  if (const auto* d = std::get_if<DoubleHgPhase>(&phase)) return DoubleHgPhase{d->g1 * scale, d->g2 * scale, d->w};
+  if (const auto* d = std::get_if<DoubleHgPhase>(&phase))
+    return DoubleHgPhase{d->g1 * scale, d->g2 * scale, d->w};
   if (std::holds_alternative<IsotropicPhase>(phase) || scale >= 1.0) return phase;
   // Blend towards isotropic: tabulate c P + (1 - c) / (4 pi).
   std::vector<double> theta, value;
@@ -35,13 +37,15 @@ Phase scale_phase_eccentricity(const Phase& phase, double scale) {
   return make_tabulated_phase("octave", theta, value);
 }
 
-OctaveIntegrator::OctaveIntegrator(const SceneContext& context, OctaveSettings settings) : ctx_(context), s_(settings) {
+OctaveIntegrator::OctaveIntegrator(const SceneContext& context, OctaveSettings settings)
+    : ctx_(context), s_(settings) {
   for (int j = 0; j < s_.octaves; ++j) {
     phases_.emplace_back();
     for (int i = 0; i < ctx_.media.count(); ++i)
       phases_.back().push_back(scale_phase_eccentricity(ctx_.media.phase(i), std::pow(s_.c, j)));
   }
-  for (const Light& l : ctx_.lights) maps_.emplace_back(ctx_.media, ctx_.majorants, l, s_.shadow_map_resolution, 0.05);
+  for (const Light& l : ctx_.lights)
+    maps_.emplace_back(ctx_.media, ctx_.majorants, l, s_.shadow_map_resolution, 0.05);
 }
 
 Rgb OctaveIntegrator::sample(double px, double py, Rng& rng) const {
@@ -59,59 +63,54 @@ Rgb OctaveIntegrator::radiance(const Vec3& o, const Vec3& d, Rng& rng) const {
   Rgb L(0.0), tau(0.0);
   const double jitter = rng.uniform();
   MediumPoint mp;
-  ctx_.majorants.traverse(o, d, 0.0, std::numeric_limits<double>::infinity(),
-                          [&](double t0, double t1, double maj) {
-    if (maj <= 0.0) return true;
-    const int n = std::max(1, int(std::ceil((t1 - t0) * maj / s_.tau_step)));
-    const double dt = (t1 - t0) / n;
-    for (int k = 0; k < n; ++k) {
-      const Vec3 p = o + d * (t0 + (k + jitter) * dt);
-      ctx_.media.eval(p, &mp);
-      if (max_component(mp.sigma_s) > 0.0) {
-        const Rgb tau_here = tau + mp.sigma_t() * (jitter * dt);
-        // Light transmittance exp(-tau_l) once per light (octave j: raised to b^j).
-        std::vector<LightSample> ls(ctx_.lights.size());
-        std::vector<Rgb> tl(ctx_.lights.size());
-        std::vector<bool> ok(ctx_.lights.size());
-        for (size_t l = 0; l < ctx_.lights.size(); ++l) {
-          const double u1 = rng.uniform(), u2 = rng.uniform();
-          ok[l] = sample_light(ctx_.lights[l], p, u1, u2, &ls[l]);
-          if (ok[l]) tl[l] = maps_[l].lookup(p);
-        }
-        for (int j = 0; j < N; ++j) {
-          Rgb Tc;
-          for (int c = 0; c < 3; ++c) Tc[c] = std::exp(-bj[j] * tau_here[c]);
-          if (max_component(Tc) < 1e-7) continue;
-          Rgb in_scatter(0.0);
-          for (int i = 0; i < mp.count; ++i) {
-            if (max_component(mp.sigma_s_i[i]) <= 0.0) continue;
-            const Phase& phase = phases_[j][i];
-            Rgb Li(0.0);
+  march(ctx_.majorants, o, d, std::numeric_limits<double>::infinity(), s_.tau_step, jitter,
+        [&](const Vec3& p, double, double dt) {
+          ctx_.media.eval(p, &mp);
+          if (max_component(mp.sigma_s) > 0.0) {
+            const Rgb tau_here = tau + mp.sigma_t() * (jitter * dt);
+            // Light transmittance exp(-tau_l) once per light (octave j: raised to b^j).
+            std::vector<LightSample> ls(ctx_.lights.size());
+            std::vector<Rgb> tl(ctx_.lights.size());
+            std::vector<bool> ok(ctx_.lights.size());
             for (size_t l = 0; l < ctx_.lights.size(); ++l) {
-              if (!ok[l]) continue;
-              const double f = phase_eval(phase, dot(d, ls[l].wi));
-              Rgb T;
-              for (int c = 0; c < 3; ++c) T[c] = std::pow(std::max(float(tl[l][c]), 1e-30f), bj[j]);
-              Li += ls[l].weight * f * T;
-            }
-            if (ctx_.has_environment) {
               const double u1 = rng.uniform(), u2 = rng.uniform();
-              const Vec3 wi = phase_sample(phase, d, u1, u2);
-              const Rgb T = marched_transmittance(ctx_.media, ctx_.majorants, p, wi,
-                                                  std::numeric_limits<double>::infinity(), 0.25 / std::max(bj[j], 0.05));
-              Rgb Tb;
-              for (int c = 0; c < 3; ++c) Tb[c] = std::pow(std::max(T[c], 1e-300), bj[j]);
-              Li += ctx_.environment * Tb;
+              ok[l] = sample_light(ctx_.lights[l], p, u1, u2, &ls[l]);
+              if (ok[l]) tl[l] = maps_[l].lookup(p);
             }
-            in_scatter += mp.sigma_s_i[i] * Li;
+            for (int j = 0; j < N; ++j) {
+              Rgb Tc;
+              for (int c = 0; c < 3; ++c) Tc[c] = std::exp(-bj[j] * tau_here[c]);
+              if (max_component(Tc) < 1e-7) continue;
+              Rgb in_scatter(0.0);
+              for (int i = 0; i < mp.count; ++i) {
+                if (max_component(mp.sigma_s_i[i]) <= 0.0) continue;
+                const Phase& phase = phases_[j][i];
+                Rgb Li(0.0);
+                for (size_t l = 0; l < ctx_.lights.size(); ++l) {
+                  if (!ok[l]) continue;
+                  const double f = phase_eval(phase, dot(d, ls[l].wi));
+                  Rgb T;
+                  for (int c = 0; c < 3; ++c) T[c] = std::pow(std::max(float(tl[l][c]), 1e-30f), bj[j]);
+                  Li += ls[l].weight * f * T;
+                }
+                if (ctx_.has_environment) {
+                  const double u1 = rng.uniform(), u2 = rng.uniform();
+                  const Vec3 wi = phase_sample(phase, d, u1, u2);
+                  const Rgb T = marched_transmittance(ctx_.media, ctx_.majorants, p, wi,
+                                                      std::numeric_limits<double>::infinity(),
+                                                      0.25 / std::max(bj[j], 0.05));
+                  Rgb Tb;
+                  for (int c = 0; c < 3; ++c) Tb[c] = std::pow(std::max(T[c], 1e-300), bj[j]);
+                  Li += ctx_.environment * Tb;
+                }
+                in_scatter += mp.sigma_s_i[i] * Li;
+              }
+              L += Tc * in_scatter * (aj[j] * dt);
+            }
           }
-          L += Tc * in_scatter * (aj[j] * dt);
-        }
-      }
-      tau += mp.sigma_t() * dt;
-    }
-    return min_component(tau) * bj[N - 1] < 14.0;
-  });
+          tau += mp.sigma_t() * dt;
+          return min_component(tau) * bj[N - 1] < 14.0;
+        });
   if (ctx_.has_environment) L += exp(-tau) * ctx_.environment;
   return L;
 }

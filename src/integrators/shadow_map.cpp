@@ -2,6 +2,7 @@
 
 #include <tbb/parallel_for.h>
 
+#include "integrators/tracking.h"
 #include "render/lights.h"
 
 namespace nimbus {
@@ -18,18 +19,16 @@ Rgb reduced_sigma_t(const SceneMedia& media, const Vec3& p, const std::vector<do
 Rgb marched_transmittance(const SceneMedia& media, const MajorantGrid& grid, const Vec3& p, const Vec3& w,
                           double tmax, double tau_step, const std::vector<double>& peak_fraction) {
   Rgb tau(0.0);
-  grid.traverse(p, w, 0.0, tmax, [&](double t0, double t1, double maj) {
-    if (maj <= 0.0) return true;
-    const int n = std::max(1, int(std::ceil((t1 - t0) * maj / tau_step)));
-    const double dt = (t1 - t0) / n;
-    for (int k = 0; k < n; ++k) tau += reduced_sigma_t(media, p + w * (t0 + (k + 0.5) * dt), peak_fraction) * dt;
+  march(grid, p, w, tmax, tau_step, 0.5, [&](const Vec3& x, double, double dt) {
+    tau += reduced_sigma_t(media, x, peak_fraction) * dt;
     return min_component(tau) < 50.0;
   });
   return exp(-tau);
 }
 
 TransmittanceGrid::TransmittanceGrid(const SceneMedia& media, const MajorantGrid& grid, const Light& light,
-                                     int resolution, double tau_step, const std::vector<double>& peak_fraction) {
+                                     int resolution, double tau_step,
+                                     const std::vector<double>& peak_fraction) {
   bounds_ = grid.bounds();
   if (bounds_.empty()) {
     bounds_.lo = Vec3(0.0);
@@ -50,8 +49,8 @@ TransmittanceGrid::TransmittanceGrid(const SceneMedia& media, const MajorantGrid
         Rgb T(1.0);
         // The centre of the light (a sun disc is treated as its centre direction here).
         if (const auto* d = std::get_if<DirectionalLight>(&light)) {
-          T = marched_transmittance(media, grid, p, -d->direction, std::numeric_limits<double>::infinity(), tau_step,
-                                    peak_fraction);
+          T = marched_transmittance(media, grid, p, -d->direction, std::numeric_limits<double>::infinity(),
+                                    tau_step, peak_fraction);
         } else if (sample_light(light, p, 0.5, 0.5, &ls)) {
           T = marched_transmittance(media, grid, p, ls.wi, ls.distance, tau_step, peak_fraction);
         }

@@ -20,7 +20,8 @@ SingleSettings parse_single_settings(const nlohmann::json& options, const std::s
   return s;
 }
 
-SingleScatter::SingleScatter(const SceneContext& context, SingleSettings settings) : ctx_(context), s_(settings) {
+SingleScatter::SingleScatter(const SceneContext& context, SingleSettings settings)
+    : ctx_(context), s_(settings) {
   if (s_.shadow_map) {
     for (const Light& l : ctx_.lights)
       shadow_maps_.emplace_back(ctx_.media, ctx_.majorants, l, s_.shadow_map_resolution, 0.05);
@@ -40,47 +41,42 @@ Rgb SingleScatter::radiance(const Vec3& o, const Vec3& d, Rng& rng) const {
   Rgb L(0.0), T(1.0);
   const double jitter = rng.uniform();
   MediumPoint mp;
-  ctx_.majorants.traverse(o, d, 0.0, std::numeric_limits<double>::infinity(),
-                          [&](double t0, double t1, double maj) {
-    if (maj <= 0.0) return true;
-    const int n = std::max(1, int(std::ceil((t1 - t0) * maj / s_.tau_step)));
-    const double dt = (t1 - t0) / n;
-    for (int k = 0; k < n; ++k) {
-      const Vec3 p = o + d * (t0 + (k + jitter) * dt);
-      ctx_.media.eval(p, &mp);
-      const Rgb step_T = exp(-mp.sigma_t() * dt);
-      if (max_component(mp.sigma_s) > 0.0) {
-        // Camera-side transmittance to the sample point, then single scattering towards the lights.
-        const Rgb T_here = T * exp(-mp.sigma_t() * (jitter * dt));
-        Rgb in_scatter(0.0);
-        for (int i = 0; i < mp.count; ++i) {
-          if (max_component(mp.sigma_s_i[i]) <= 0.0) continue;
-          const Phase& phase = ctx_.media.phase(i);
-          Rgb Li(0.0);
-          for (int s = 0; s < s_.light_samples; ++s) {
-            for (size_t l = 0; l < ctx_.lights.size(); ++l) {
-              LightSample ls;
-              const double u1 = rng.uniform(), u2 = rng.uniform();
-              if (!sample_light(ctx_.lights[l], p, u1, u2, &ls)) continue;
-              const double f = phase_eval(phase, dot(d, ls.wi));
-              if (f <= 0.0) continue;
-              Li += ls.weight * f * light_transmittance(l, p, ls, rng);
+  march(ctx_.majorants, o, d, std::numeric_limits<double>::infinity(), s_.tau_step, jitter,
+        [&](const Vec3& p, double, double dt) {
+          ctx_.media.eval(p, &mp);
+          const Rgb step_T = exp(-mp.sigma_t() * dt);
+          if (max_component(mp.sigma_s) > 0.0) {
+            // Camera-side transmittance to the sample point, then single scattering towards the lights.
+            const Rgb T_here = T * exp(-mp.sigma_t() * (jitter * dt));
+            Rgb in_scatter(0.0);
+            for (int i = 0; i < mp.count; ++i) {
+              if (max_component(mp.sigma_s_i[i]) <= 0.0) continue;
+              const Phase& phase = ctx_.media.phase(i);
+              Rgb Li(0.0);
+              for (int s = 0; s < s_.light_samples; ++s) {
+                for (size_t l = 0; l < ctx_.lights.size(); ++l) {
+                  LightSample ls;
+                  const double u1 = rng.uniform(), u2 = rng.uniform();
+                  if (!sample_light(ctx_.lights[l], p, u1, u2, &ls)) continue;
+                  const double f = phase_eval(phase, dot(d, ls.wi));
+                  if (f <= 0.0) continue;
+                  Li += ls.weight * f * light_transmittance(l, p, ls, rng);
+                }
+                if (ctx_.has_environment) {
+                  const double u1 = rng.uniform(), u2 = rng.uniform();
+                  const Vec3 wi = phase_sample(phase, d, u1, u2);
+                  Li += ctx_.environment *
+                        ratio_tracking_transmittance(ctx_.media, ctx_.majorants, p, wi,
+                                                     std::numeric_limits<double>::infinity(), rng);
+                }
+              }
+              in_scatter += mp.sigma_s_i[i] * Li / double(s_.light_samples);
             }
-            if (ctx_.has_environment) {
-              const double u1 = rng.uniform(), u2 = rng.uniform();
-              const Vec3 wi = phase_sample(phase, d, u1, u2);
-              Li += ctx_.environment * ratio_tracking_transmittance(ctx_.media, ctx_.majorants, p, wi,
-                                                                    std::numeric_limits<double>::infinity(), rng);
-            }
+            L += T_here * in_scatter * dt;
           }
-          in_scatter += mp.sigma_s_i[i] * Li / double(s_.light_samples);
-        }
-        L += T_here * in_scatter * dt;
-      }
-      T *= step_T;
-    }
-    return max_component(T) > 1e-6;
-  });
+          T *= step_T;
+          return max_component(T) > 1e-6;
+        });
   if (ctx_.has_environment) L += T * ctx_.environment;
   return L;
 }

@@ -3,6 +3,7 @@
 // (transmittance) and the other integrators all build on it.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/rng.h"
@@ -33,14 +34,34 @@ bool track(const MajorantGrid& grid, const Vec3& o, const Vec3& d, double tmax, 
   return reached_end;
 }
 
-// Unbiased per-channel transmittance along o + t d, t in (0, tmax), by ratio tracking with
-// Russian roulette once every channel has fallen below 0.1.
-inline Rgb ratio_tracking_transmittance(const SceneMedia& media, const MajorantGrid& grid, const Vec3& o,
-                                        const Vec3& d, double tmax, Rng& rng) {
+// The fixed-optical-depth march of the deterministic integrators: each majorant cell's segment of
+// o + t d, t in (0, tmax), is cut into ceil(length * majorant / tau_step) equal steps, and
+// on_step(p, t, dt) -> bool is called at fraction `offset` in [0, 1) of each step (0.5: midpoint; one
+// uniform number per ray: a jittered, unbiased-in-the-limit march). Stops when on_step returns false.
+template <typename F>
+void march(const MajorantGrid& grid, const Vec3& o, const Vec3& d, double tmax, double tau_step,
+           double offset, F&& on_step) {
+  grid.traverse(o, d, 0.0, tmax, [&](double t0, double t1, double maj) {
+    if (maj <= 0.0) return true;
+    const int n = std::max(1, int(std::ceil((t1 - t0) * maj / tau_step)));
+    const double dt = (t1 - t0) / n;
+    for (int k = 0; k < n; ++k) {
+      const double t = t0 + (k + offset) * dt;
+      if (!on_step(o + d * t, t, dt)) return false;
+    }
+    return true;
+  });
+}
+
+// Unbiased per-channel transmittance along o + t d, t in (0, tmax), by ratio tracking against the
+// extinction sigma(p) -> Rgb (at most the majorant), with Russian roulette once every channel has
+// fallen below 0.1.
+template <typename Sigma>
+Rgb ratio_tracking(const MajorantGrid& grid, const Vec3& o, const Vec3& d, double tmax, Rng& rng,
+                   Sigma&& sigma) {
   Rgb T(1.0);
   track(grid, o, d, tmax, rng, [&](const Vec3& p, double maj) {
-    const Rgb sigma_t = media.sigma_t(p);
-    T *= Rgb(1.0) - sigma_t / maj;
+    T *= Rgb(1.0) - sigma(p) / maj;
     const double m = max_component(T);
     if (m <= 0.0) {
       T = Rgb(0.0);
@@ -56,6 +77,12 @@ inline Rgb ratio_tracking_transmittance(const SceneMedia& media, const MajorantG
     return true;
   });
   return T;
+}
+
+// The same with the media's full extinction.
+inline Rgb ratio_tracking_transmittance(const SceneMedia& media, const MajorantGrid& grid, const Vec3& o,
+                                        const Vec3& d, double tmax, Rng& rng) {
+  return ratio_tracking(grid, o, d, tmax, rng, [&](const Vec3& p) { return media.sigma_t(p); });
 }
 
 }  // namespace nimbus

@@ -1,0 +1,261 @@
+#include "integrators/scatter_grid.h"
+
+#include <tbb/parallel_for.h>
+
+#include <cmath>
+
+#include "integrators/shadow_map.h"
+#include "integrators/tracking.h"
+
+namespace nimbus {
+namespace {
+
+constexpr int kBatches = 8;             // fixed: the grid must not depend on the thread count
+constexpr int kMaxWideScatters = 1024;  // photons are ended after this many wide scatters
+constexpr int kFloatsPerNode = 12;
+
+struct Photon {
+  Vec3 x, w;
+  Rgb power;
+};
+
+// A photon leaving the light `source` (lights first, then the environment) towards the media's
+// bounding sphere (centre c, radius r); power per photon for n photons of that source.
+Photon emit(const SceneContext& ctx, size_t source, const Vec3& c, double r, double n, Rng& rng) {
+  const double u1 = rng.uniform(), u2 = rng.uniform(), u3 = rng.uniform(), u4 = rng.uniform();
+  const double disc_area = kPi * r * r;
+  auto through_disc = [&](const Vec3& w) {
+    const Frame frame(w);
+    const double rr = r * std::sqrt(u3), phi = 2.0 * kPi * u4;
+    return c - w * (2.0 * r) + frame.to_world({rr * std::cos(phi), rr * std::sin(phi), 0.0});
+  };
+  Photon p;
+  if (source < ctx.lights.size()) {
+    const Light& light = ctx.lights[source];
+    if (const auto* d = std::get_if<DirectionalLight>(&light)) {
+      p.w = normalize(d->direction);
+      p.x = through_disc(p.w);
+      p.power = d->irradiance * (disc_area / n);
+    } else if (const auto* pt = std::get_if<PointLight>(&light)) {
+      const Vec3 v = c - pt->position;
+      const double dist = v.length();
+      p.x = pt->position;
+      if (dist > r) {
+        const double cos_max = std::sqrt(std::max(0.0, 1.0 - r * r / (dist * dist)));
+        p.w = spherical_direction(1.0 - u1 * (1.0 - cos_max), 2.0 * kPi * u2, v / dist);
+        p.power = pt->intensity * (2.0 * kPi * (1.0 - cos_max) / n);
+      } else {
+        p.w = spherical_direction(1.0 - 2.0 * u1, 2.0 * kPi * u2, Vec3(0, 0, 1));
+        p.power = pt->intensity * (4.0 * kPi / n);
+      }
+    }
+  } else {
+    // Uniform radiance L from every direction: flux L 4 pi A through a disc of area A.
+    p.w = spherical_direction(1.0 - 2.0 * u1, 2.0 * kPi * u2, Vec3(0, 0, 1));
+    p.x = through_disc(p.w);
+    p.power = ctx.environment * (4.0 * kPi * disc_area / n);
+  }
+  return p;
+}
+
+}  // namespace
+
+ScatterGrid::ScatterGrid(const SceneContext& ctx, const std::vector<const PhaseSplit*>& splits,
+                         const std::vector<double>& peak_fraction, const ScatterGridSettings& s) {
+  const Bounds media_bounds = ctx.media.bounds();
+  if (media_bounds.empty()) {
+    bounds_.lo = Vec3(0.0);
+    bounds_.hi = Vec3(1.0);
+    values_.assign(size_t(8) * kFloatsPerNode, 0.0f);
+    return;
+  }
+  const Vec3 extent = media_bounds.hi - media_bounds.lo;
+  const double longest = std::max({extent.x, extent.y, extent.z});
+  for (int a = 0; a < 3; ++a) {
+    // Nodes cover the media's bounds, plus one spacing of padding on each side so every point of the
+    // media has a node's full support around it.
+    const int inner = std::max(2, int(std::ceil(extent[a] / longest * (s.resolution - 1))) + 1);
+    spacing_[a] = std::max(extent[a], 1e-6 * longest) / (inner - 1);
+    nodes_[a] = inner + 2;
+    bounds_.lo[a] = media_bounds.lo[a] - spacing_[a];
+    bounds_.hi[a] = bounds_.lo[a] + spacing_[a] * (nodes_[a] - 1);
+  }
+  const size_t node_count = size_t(nodes_[0]) * nodes_[1] * nodes_[2];
+  values_.assign(node_count * kFloatsPerNode, 0.0f);
+  if (s.max_wide_scatters == 1) return;  // nothing beyond the first wide scatter
+
+  // Grey media (every coefficient equal in all channels) take one pass carrying RGB power; otherwise
+  // one pass per channel with that channel's coefficients.
+  bool grey = true;
+  for (int i = 0; i < ctx.media.count(); ++i) {
+    const Medium& m = ctx.media.medium(i);
+    grey = grey && m.sigma_s.x == m.sigma_s.y && m.sigma_s.y == m.sigma_s.z && m.sigma_a.x == m.sigma_a.y &&
+           m.sigma_a.y == m.sigma_a.z;
+  }
+  const int passes = grey ? 1 : 3;
+  const size_t sources = ctx.lights.size() + (ctx.has_environment ? 1 : 0);
+  if (sources == 0 || s.photons <= 0) return;
+  const size_t per_source = std::max<size_t>(1, size_t(s.photons) / sources);
+  const size_t total = size_t(passes) * sources * per_source;
+  photons_traced_ = double(total);
+
+  const Vec3 centre = (media_bounds.lo + media_bounds.hi) * 0.5;
+  const double radius = 0.5 * extent.length() * (1.0 + 1e-9) + 1e-12;
+  const double h_min = std::min({spacing_.x, spacing_.y, spacing_.z});
+  const int K = s.max_wide_scatters <= 0 ? kMaxWideScatters : std::min(s.max_wide_scatters, kMaxWideScatters);
+  const int media_count = ctx.media.count();
+
+  std::vector<std::vector<float>> batch(kBatches);
+  tbb::parallel_for(0, kBatches, [&](int b) {
+    std::vector<float>& g = batch[b];
+    g.assign(node_count * kFloatsPerNode, 0.0f);
+    // Splat value `v` (per channel; only channels with a non-zero entry) with direction w at q.
+    auto splat = [&](const Vec3& q, const Vec3& w, const Rgb& v) {
+      int i[3];
+      double fr[3];
+      for (int a = 0; a < 3; ++a) {
+        const double u = std::clamp((q[a] - bounds_.lo[a]) / spacing_[a], 0.0, double(nodes_[a] - 1));
+        i[a] = std::min(int(u), nodes_[a] - 2);
+        fr[a] = u - i[a];
+      }
+      for (int k = 0; k < 8; ++k) {
+        const int dx = k & 1, dy = (k >> 1) & 1, dz = (k >> 2) & 1;
+        const double wt = (dx ? fr[0] : 1 - fr[0]) * (dy ? fr[1] : 1 - fr[1]) * (dz ? fr[2] : 1 - fr[2]);
+        if (wt <= 0.0) continue;
+        float* node =
+            &g[((size_t(i[2] + dz) * nodes_[1] + i[1] + dy) * nodes_[0] + i[0] + dx) * kFloatsPerNode];
+        for (int c = 0; c < 3; ++c) {
+          if (v[c] == 0.0) continue;
+          const double e = wt * v[c];
+          node[4 * c + 0] += float(e);
+          node[4 * c + 1] += float(e * w.x);
+          node[4 * c + 2] += float(e * w.y);
+          node[4 * c + 3] += float(e * w.z);
+        }
+      }
+    };
+    // Track-length deposit of the flight x + t w, t in [0, t_end] (clipped to the node grid).
+    auto deposit = [&](const Vec3& x, const Vec3& w, double t_end, const Rgb& power) {
+      double t0, t1;
+      if (!bounds_.intersect(x, w, 0.0, t_end, &t0, &t1)) return;
+      const double len = t1 - t0;
+      if (!(len > 0.0)) return;
+      const int n = std::max(1, int(std::ceil(len / (0.5 * h_min))));
+      const Rgb v = power * (len / n);
+      for (int k = 0; k < n; ++k) splat(x + w * (t0 + (k + 0.5) * len / n), w, v);
+    };
+
+    const size_t begin = total * size_t(b) / kBatches, end = total * size_t(b + 1) / kBatches;
+    MediumPoint mp;
+    for (size_t j = begin; j < end; ++j) {
+      Rng rng(s.seed ^ 0x6d756c7469706c65ull, j);
+      const int pass = int(j / (sources * per_source));
+      const size_t source = (j / per_source) % sources;
+      const int c = pass;  // the channel whose coefficients drive this photon
+      Photon ph = emit(ctx, source, centre, radius, double(per_source), rng);
+      Rgb power = ph.power;
+      if (!grey)
+        for (int k = 0; k < 3; ++k)
+          if (k != c) power[k] = 0.0;
+      if (max_component(power) <= 0.0) continue;
+      Vec3 x = ph.x, w = ph.w;
+      double weight = 1.0;
+      for (int order = 0;; ++order) {
+        bool hit = false;
+        Vec3 xc;
+        track(ctx.majorants, x, w, std::numeric_limits<double>::infinity(), rng,
+              [&](const Vec3& p, double maj) {
+                if (rng.uniform() * maj < reduced_sigma_t(ctx.media, p, peak_fraction)[c]) {
+                  hit = true;
+                  xc = p;
+                  return false;
+                }
+                return true;
+              });
+        if (order >= 1)
+          deposit(x, w, hit ? (xc - x).length() : std::numeric_limits<double>::infinity(), power * weight);
+        if (!hit || order + 1 >= K) break;
+        // A wide scatter at xc (or absorption): albedo weight, roulette, medium, direction.
+        ctx.media.eval(xc, &mp);
+        double wide[kMaxMedia], wide_sum = 0.0;
+        for (int i = 0; i < mp.count && i < media_count; ++i) {
+          wide[i] = (1.0 - peak_fraction[i]) * mp.sigma_s_i[i][c];
+          wide_sum += wide[i];
+        }
+        const double sigma_red = mp.sigma_a[c] + wide_sum;
+        if (!(wide_sum > 0.0) || !(sigma_red > 0.0)) break;
+        weight *= wide_sum / sigma_red;
+        if (weight < 0.1) {
+          if (rng.uniform() * 0.1 >= weight) break;
+          weight = 0.1;
+        }
+        double u = rng.uniform() * wide_sum;
+        int m = 0;
+        while (m + 1 < mp.count && u >= wide[m]) u -= wide[m++];
+        // P_wide by rejection from P: accept with (1 - f) P_wide / P (<= 1), expected 1 / (1 - f) tries.
+        const Phase& phase = ctx.media.phase(m);
+        const double f = peak_fraction[m];
+        Vec3 w_new = w;
+        for (int tries = 0; tries < 10000; ++tries) {
+          const double v1 = rng.uniform(), v2 = rng.uniform();
+          const Vec3 cand = phase_sample(phase, w, v1, v2);
+          const double mu = dot(cand, w), p_full = phase_eval(phase, mu);
+          const double accept = p_full > 0.0 ? (1.0 - f) * splits[m]->wide(mu) / p_full : 1.0;
+          if (rng.uniform() < accept) {
+            w_new = cand;
+            break;
+          }
+        }
+        x = xc;
+        w = w_new;
+      }
+    }
+  });
+
+  // Sum the batches in order, divide by the node volume: fluence and flux.
+  const double inv_volume = 1.0 / (spacing_.x * spacing_.y * spacing_.z);
+  tbb::parallel_for(size_t(0), node_count, [&](size_t n) {
+    for (int k = 0; k < kFloatsPerNode; ++k) {
+      double sum = 0.0;
+      for (int b = 0; b < kBatches; ++b) sum += batch[b][n * kFloatsPerNode + k];
+      values_[n * kFloatsPerNode + k] = float(sum * inv_volume);
+    }
+  });
+}
+
+void ScatterGrid::lookup(const Vec3& p, Rgb* phi, std::array<Rgb, 3>* flux) const {
+  *phi = Rgb(0.0);
+  for (Rgb& f : *flux) f = Rgb(0.0);
+  if (!bounds_.contains(p)) return;
+  int i[3];
+  double fr[3];
+  for (int a = 0; a < 3; ++a) {
+    const double u = std::clamp((p[a] - bounds_.lo[a]) / spacing_[a], 0.0, double(nodes_[a] - 1));
+    i[a] = std::min(int(u), nodes_[a] - 2);
+    fr[a] = u - i[a];
+  }
+  for (int k = 0; k < 8; ++k) {
+    const int dx = k & 1, dy = (k >> 1) & 1, dz = (k >> 2) & 1;
+    const double wt = (dx ? fr[0] : 1 - fr[0]) * (dy ? fr[1] : 1 - fr[1]) * (dz ? fr[2] : 1 - fr[2]);
+    const float* node =
+        &values_[((size_t(i[2] + dz) * nodes_[1] + i[1] + dy) * nodes_[0] + i[0] + dx) * kFloatsPerNode];
+    for (int c = 0; c < 3; ++c) {
+      (*phi)[c] += wt * node[4 * c];
+      for (int a = 0; a < 3; ++a) (*flux)[a][c] += wt * node[4 * c + 1 + a];
+    }
+  }
+}
+
+Rgb ScatterGrid::scattered(const Vec3& p, const Vec3& w_out, const Rgb& g) const {
+  Rgb phi;
+  std::array<Rgb, 3> flux;
+  lookup(p, &phi, &flux);
+  Rgb r;
+  for (int c = 0; c < 3; ++c) {
+    const double f_dot_w = flux[0][c] * w_out.x + flux[1][c] * w_out.y + flux[2][c] * w_out.z;
+    r[c] = std::max(0.0, (phi[c] + 3.0 * g[c] * f_dot_w) / (4.0 * kPi));
+  }
+  return r;
+}
+
+}  // namespace nimbus
