@@ -113,7 +113,10 @@ void add_render_command(CLI::App& app, Action& action) {
   cmd->add_option("--spp", args->spp, "Samples per pixel (overrides the scene)")->check(CLI::Range(1, kMaxSpp));
   cmd->add_option("--threads", args->threads, "Worker threads (0 = all cores)")->check(CLI::Range(0, 4096));
   cmd->add_option("--seed", args->seed, "Random seed (overrides the scene)");
-  cmd->add_option("--integrator", args->integrator, "Integrator (overrides the scene): pathtrace");
+  std::string names;
+  for (const std::string& n : integrator_names()) names += (names.empty() ? "" : ", ") + n;
+  cmd->add_option("--integrator", args->integrator, "Integrator (overrides the scene): " + names)
+      ->check(CLI::IsMember(integrator_names()));
   cmd->add_option("--exposure", args->exposure, "Exposure in stops for PNG output")->check(CLI::Range(-64.0, 64.0));
   cmd->add_flag("-q,--quiet", args->quiet, "No progress bar or summary");
   cmd->callback([args, &action] { action = [args] { return run_render(*args); }; });

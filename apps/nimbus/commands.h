@@ -14,6 +14,7 @@ using Action = std::function<int()>;
 void add_render_command(CLI::App& app, Action& action);
 void add_compare_command(CLI::App& app, Action& action);
 void add_info_command(CLI::App& app, Action& action);
+void add_convert_command(CLI::App& app, Action& action);
 void add_beam_command(CLI::App& app, Action& action);
 void add_slab_command(CLI::App& app, Action& action);
 

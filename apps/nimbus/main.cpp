@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
   add_render_command(app, action);
   add_compare_command(app, action);
   add_info_command(app, action);
+  add_convert_command(app, action);
   add_beam_command(app, action);
   add_slab_command(app, action);
   try {

@@ -108,5 +108,20 @@ TEST(RenderCli, SigintWritesAFlaggedPartialImage) {
   EXPECT_EQ(content, "precious");
 }
 
+TEST(RenderCli, ConvertWritesAPngAndRejectsBadInput) {
+  const test::ScratchDir scratch("render_cli_convert");
+  const fs::path& dir = scratch.path;
+  write_scene(dir / "s.json", 8, 1);
+  ASSERT_EQ(run("render " + (dir / "s.json").string() + " -o " + (dir / "a.exr").string() + " --quiet"), 0);
+  ASSERT_EQ(run("convert " + (dir / "a.exr").string() + " " + (dir / "a.png").string() + " --exposure 1"), 0);
+  EXPECT_GT(fs::file_size(dir / "a.png"), 0u);
+  std::ofstream(dir / "bad.exr") << "not an exr";
+  EXPECT_EQ(run("convert " + (dir / "bad.exr").string() + " " + (dir / "b.png").string() + " 2>/dev/null"), 2);
+  EXPECT_FALSE(fs::exists(dir / "b.png"));
+  EXPECT_EQ(run("render " + (dir / "s.json").string() + " -o " + (dir / "c.exr").string() +
+                " --integrator mfs --quiet"),
+            0);
+}
+
 }  // namespace
 }  // namespace nimbus
