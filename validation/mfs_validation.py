@@ -1,102 +1,250 @@
 #!/usr/bin/env python3
-"""Validation of `mfs` and the `octave` baseline against the path-traced reference.
+"""Validation of `mfs` (each option), `single` and the `octave` baseline against the path tracer.
 
-Renders small scenes (validation/scenes/*.json and the Disney cloud at low resolution) with pathtrace
-(reference, cached in validation/refs/, git-ignored), single, mfs (each option) and octave; writes the
-table in docs/validation/render.md (between the markers) and side-by-side PNGs.
+The suite (issue 4): homogeneous spheres and a box of optical radius 1 to 50, albedo 0.9 to 0.9999,
+HG g 0.7 to 0.95 and a double HG, light from the side, the front (behind the camera) and the back,
+chromatic coefficients, and the Disney cloud at two densities. For each scene:
+  - a converged pathtrace reference (cached in validation/refs/, git-ignored) and a second, independent
+    half-spp render whose difference estimates the reference's own noise;
+  - every deterministic configuration: whole-image mean error (luminance), relative RMSE over 4x4 bins
+    with reference >= 5 % of the mean (`nimbus compare --bin 4 --min-ref 0.05`), wall time;
+  - pathtrace at 4, 16, 64 spp (error against time), from which the time path tracing needs to reach
+    the rel RMSE of `mfs` is read off (rel RMSE ~ c / sqrt(spp)): the equal-error speed-up.
+Writes docs/validation/render_results.json, render_table.md (included in render.md by hand),
+render_suite.png (reference | mfs | octave | single | mfs error) and render_error_time.png.
 
-    validation/mfs_validation.py [--ref-spp 4096] [--only SCENE] [--fast]
-Heavy: run with `nice`. Needs build/bin/nimbus.
+    nice validation/mfs_validation.py [--only NAME] [--scale 1.0]
+Needs build/bin/nimbus, /usr/bin/python3 with numpy + matplotlib. ~1 h on 2 cores (references).
 """
-import argparse, json, os, subprocess, sys, time
+import argparse, json, math, os, subprocess, sys, time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 NIMBUS = os.path.join(ROOT, "build", "bin", "nimbus")
-SCENES = os.path.join(ROOT, "validation", "scenes")
 REFS = os.path.join(ROOT, "validation", "refs")
 DOCS = os.path.join(ROOT, "docs", "validation")
-TMP = os.path.join(ROOT, "validation", "refs", "tmp")
+TMP = os.path.join(REFS, "tmp")
+IMG = os.path.join(DOCS, "render")
 
-# (label, integrator block, spp)
-CONFIGS = [
-    ("single", {"type": "single"}, 4),
-    ("octave", {"type": "octave"}, 4),
+CONFIGS = [  # (label, integrator block, spp)
     ("mfs", {"type": "mfs"}, 4),
+    ("mfs K=1", {"type": "mfs", "large_angle_scatters": 1}, 4),
+    ("mfs K=2", {"type": "mfs", "large_angle_scatters": 2}, 4),
+    ("mfs K=3", {"type": "mfs", "large_angle_scatters": 3}, 4),
+    ("mfs similarity photons", {"type": "mfs", "photon_transport": "similarity"}, 4),
+    ("mfs light side", {"type": "mfs", "forward_side": "light"}, 4),
+    ("mfs L1 grid", {"type": "mfs", "scatter_grid_bands": 2}, 4),
     ("mfs beer_lambert", {"type": "mfs", "light_path": "beer_lambert"}, 4),
     ("mfs gaussian", {"type": "mfs", "propagator": "gaussian"}, 4),
-    ("mfs f=0.5", {"type": "mfs", "peak_fraction": 0.5}, 4),
-    ("mfs f=0.93", {"type": "mfs", "peak_fraction": 0.93}, 4),
+    ("mfs f=0", {"type": "mfs", "peak_fraction": 0.0}, 4),
+    ("octave", {"type": "octave"}, 4),
+    ("single", {"type": "single"}, 4),
 ]
+PT_SPP = [4, 16, 64]
+
+SIDE, FRONT, BACK = [1, 0, 0], [0.2, 1, -0.25], [0.2, -1, 0.25]
 
 
-def scenes():
-    out = []
-    for f in sorted(os.listdir(SCENES)):
-        if f.endswith(".json"):
-            out.append((f[:-5], json.load(open(os.path.join(SCENES, f))), SCENES))
-    cloud = json.load(open(os.path.join(ROOT, "scenes", "disney_cloud.json")))
-    cloud["camera"]["width"], cloud["camera"]["height"] = 64, 48
-    out.append(("disney_cloud_64", cloud, os.path.join(ROOT, "scenes")))
-    return out
+def homogeneous(shape, tau, albedo, phase, light, res=48, chroma=None, ref_spp=2048):
+    """Unit sphere / box (half-size 1) of optical radius tau seen from 4 units."""
+    ss = albedo * tau
+    sa = (1 - albedo) * tau
+    if chroma:
+        ss = [ss * c for c in chroma]
+    geo = ({"type": "sphere", "center": [0, 0, 0], "radius": 1} if shape == "sphere"
+           else {"type": "box", "min": [-1, -1, -1], "max": [1, 1, 1]})
+    return ({"camera": {"position": [0, -4, 0] if shape == "sphere" else [-2.2, -4, 1.6], "look_at": [0, 0, 0],
+                        "up": [0, 0, 1], "fov_y_deg": 35 if shape == "sphere" else 45, "width": res, "height": res},
+             "media": [{"shape": geo, "sigma_s": ss, "sigma_a": sa, "phase": phase}],
+             "lights": [{"type": "directional", "direction": light, "irradiance": 1.0}]},
+            ROOT, ref_spp)
 
 
-def render(scene, base_dir, block, spp, out, extra=()):
+def hg(g):
+    return {"type": "hg", "g": g}
+
+
+def cloud(sigma_s):
+    s = json.load(open(os.path.join(ROOT, "scenes", "disney_cloud.json")))
+    s["camera"]["width"], s["camera"]["height"] = 64, 48
+    s["media"][0]["sigma_s"] = sigma_s
+    return s, os.path.join(ROOT, "scenes"), 2048
+
+
+def suite():
+    return {
+        "sphere_r1_a0.9_hg0.7_side": homogeneous("sphere", 1, 0.9, hg(0.7), SIDE),
+        "sphere_r2_a0.99_hg0.85_side": homogeneous("sphere", 2, 0.99, hg(0.85), SIDE),
+        "sphere_r2_a0.99_hg0.85_front": homogeneous("sphere", 2, 0.99, hg(0.85), FRONT),
+        "sphere_r10_a0.99_hg0.85_side": homogeneous("sphere", 10, 0.99, hg(0.85), SIDE),
+        "sphere_r10_a0.99_hg0.85_front": homogeneous("sphere", 10, 0.99, hg(0.85), FRONT),
+        "sphere_r10_a0.99_hg0.85_back": homogeneous("sphere", 10, 0.99, hg(0.85), BACK, ref_spp=8192),
+        "sphere_r10_a0.999_dhg_side": homogeneous("sphere", 10, 0.999,
+                                                  {"type": "double_hg", "g1": 0.9, "g2": -0.4, "w": 0.85}, SIDE),
+        "box_r5_a0.999_hg0.9_side_rgb": homogeneous("box", 5, 0.999, hg(0.9), SIDE, chroma=[0.8, 1.0, 1.25]),
+        "sphere_r20_a0.9999_hg0.95_back": homogeneous("sphere", 20, 0.9999, hg(0.95), BACK, res=32, ref_spp=16384),
+        "sphere_r50_a0.9999_hg0.85_side": homogeneous("sphere", 50, 0.9999, hg(0.85), SIDE, res=32, ref_spp=512),
+        "disney_cloud": cloud(0.2),
+        "disney_cloud_thin": cloud(0.05),
+    }
+
+
+def render(scene, base_dir, block, spp, out, seed=1):
     s = dict(scene)
-    s["integrator"] = dict(block, spp=spp, seed=1)
-    path = os.path.join(base_dir, ".mfs_validation_tmp.json")  # relative VDB paths resolve from base_dir
+    s["integrator"] = dict(block, spp=spp, seed=seed)
+    path = os.path.join(base_dir, f".mfs_validation_{os.getpid()}.json")  # relative paths resolve from base_dir
     json.dump(s, open(path, "w"))
     t0 = time.time()
-    subprocess.run(["nice", NIMBUS, "render", path, "-o", out, "--quiet", *extra], check=True)
-    dt = time.time() - t0
-    os.remove(path)
-    return dt
+    try:
+        subprocess.run([NIMBUS, "render", path, "-o", out, "--quiet"], check=True)
+    finally:
+        os.remove(path)
+    return time.time() - t0
 
 
 def compare(a, b):
     r = subprocess.run([NIMBUS, "compare", a, b, "--bin", "4", "--min-ref", "0.05", "--json"],
                        check=True, capture_output=True, text=True)
     j = json.loads(r.stdout)
-    return j["mean_luminance_a"] / j["mean_luminance_b"] - 1.0, j["rel_rmse"]
+    return j["mean_luminance_a"] / j["mean_luminance_b"] - 1.0, j["rel_rmse"], j["mean_luminance_b"]
+
+
+def png(exr, out, exposure, heat_ref=None):
+    if heat_ref:
+        subprocess.run([NIMBUS, "compare", exr, heat_ref, "--heatmap", out, "--heatmap-range", "0.5"], check=True,
+                       capture_output=True)
+    else:
+        subprocess.run([NIMBUS, "convert", exr, out, "--exposure", f"{exposure:.3f}"], check=True)
 
 
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("--ref-spp", type=int, default=4096)
     ap.add_argument("--only")
     args = ap.parse_args()
     os.makedirs(TMP, exist_ok=True)
-    rows = []
-    for name, scene, base in scenes():
-        if args.only and args.only != name:
+    os.makedirs(IMG, exist_ok=True)
+    results_path = os.path.join(DOCS, "render_results.json")
+    results = json.load(open(results_path)) if os.path.exists(results_path) else {}
+    for name, (scene, base, ref_spp) in suite().items():
+        if args.only and args.only not in name:
             continue
-        ref = os.path.join(REFS, f"{name}_pt{args.ref_spp}.exr")
+        ref = os.path.join(REFS, f"{name}_pt{ref_spp}.exr")
+        half = os.path.join(REFS, f"{name}_pt{ref_spp // 2}_seed2.exr")
         if not os.path.exists(ref):
-            t = render(scene, base, {"type": "pathtrace"}, args.ref_spp, ref)
-            print(f"{name}: reference {args.ref_spp} spp in {t:.1f}s", flush=True)
-        render(scene, base, {"type": "pathtrace"}, 256, os.path.join(DOCS, f"mfs_{name}_pathtrace.png"), ("--exposure", "2"))
+            t = render(scene, base, {"type": "pathtrace"}, ref_spp, ref)
+            print(f"{name}: reference {ref_spp} spp in {t:.1f}s", flush=True)
+        if not os.path.exists(half):
+            render(scene, base, {"type": "pathtrace"}, ref_spp // 2, half, seed=2)
+        _, half_rrmse, ref_mean = compare(half, ref)
+        noise = half_rrmse / math.sqrt(3.0)  # var(half - full) = 3 var(full)
+        exposure = math.log2(0.3 / max(ref_mean, 1e-12))
+        r = {"reference_spp": ref_spp, "reference_noise_rel_rmse": noise, "configs": {}, "pathtrace": []}
+        png(ref, os.path.join(IMG, f"{name}_reference.png"), exposure)
         for label, block, spp in CONFIGS:
-            out = os.path.join(TMP, f"{name}_{label.replace(' ', '_')}.exr")
+            out = os.path.join(TMP, f"{name}_{label.replace(' ', '_').replace('=', '')}.exr")
             t = render(scene, base, block, spp, out)
-            mean, rrmse = compare(out, ref)
-            rows.append((name, label, mean, rrmse, t))
-            print(f"{name:20s} {label:20s} mean {mean:+.3f} rrmse {rrmse:.3f} time {t:.2f}s", flush=True)
-            if label in ("single", "octave", "mfs"):
-                render(scene, base, block, spp, os.path.join(DOCS, f"mfs_{name}_{label}.png"), ("--exposure", "2"))
-        # Equal-time path tracing: as many spp as the mfs render took.
-        mfs_t = [r[4] for r in rows if r[0] == name and r[1] == "mfs"][0]
-        pt_probe = render(scene, base, {"type": "pathtrace"}, 16, os.path.join(TMP, "probe.exr"))
-        spp = max(1, int(16 * mfs_t / max(pt_probe, 1e-3)))
-        out = os.path.join(TMP, f"{name}_pt_equal.exr")
-        t = render(scene, base, {"type": "pathtrace"}, spp, out)
-        mean, rrmse = compare(out, ref)
-        rows.append((name, f"pathtrace {spp} spp", mean, rrmse, t))
-        print(f"{name:20s} pathtrace {spp:5d} spp  mean {mean:+.3f} rrmse {rrmse:.3f} time {t:.2f}s", flush=True)
-    table = ["| scene | integrator | mean error | rel RMSE (4x4 bins) | time [s] |", "|---|---|---|---|---|"]
-    for name, label, mean, rrmse, t in rows:
-        table.append(f"| {name} | {label} | {mean:+.1%} | {rrmse:.1%} | {t:.2f} |")
-    text = "\n".join(table)
-    print(text)
-    open(os.path.join(REFS, "table.md"), "w").write(text + "\n")
+            mean, rrmse, _ = compare(out, ref)
+            r["configs"][label] = {"mean_error": mean, "rel_rmse": rrmse, "time_s": t}
+            print(f"{name:34s} {label:18s} mean {mean:+.3f} rrmse {rrmse:.3f} time {t:.2f}s", flush=True)
+            if label in ("mfs", "octave", "single"):
+                png(out, os.path.join(IMG, f"{name}_{label}.png"), exposure)
+            if label == "mfs":
+                png(out, os.path.join(IMG, f"{name}_mfs_error.png"), 0, heat_ref=ref)
+        for spp in PT_SPP:
+            out = os.path.join(TMP, f"{name}_pt{spp}.exr")
+            t = render(scene, base, {"type": "pathtrace"}, spp, out, seed=3)
+            mean, rrmse, _ = compare(out, ref)
+            r["pathtrace"].append({"spp": spp, "mean_error": mean, "rel_rmse": rrmse, "time_s": t})
+            print(f"{name:34s} pathtrace {spp:4d} spp  mean {mean:+.3f} rrmse {rrmse:.3f} time {t:.2f}s", flush=True)
+        # Path tracing's rel RMSE against the reference ~ sqrt(c^2 / spp + noise^2); time ~ t0 + k spp.
+        last, first = r["pathtrace"][-1], r["pathtrace"][0]
+        c2 = max(last["rel_rmse"] ** 2 - noise ** 2, 1e-12) * last["spp"]
+        k = max((last["time_s"] - first["time_s"]) / (last["spp"] - first["spp"]), 1e-9)
+        t0 = max(first["time_s"] - k * first["spp"], 0.0)
+        for label, c in r["configs"].items():
+            target2 = c["rel_rmse"] ** 2 - noise ** 2
+            if target2 <= 0:
+                c["pathtrace_equal_error_time_s"] = None
+                continue
+            spp_needed = c2 / target2
+            c["pathtrace_equal_error_spp"] = spp_needed
+            c["pathtrace_equal_error_time_s"] = t0 + k * spp_needed
+            c["speedup"] = c["pathtrace_equal_error_time_s"] / c["time_s"]
+        results[name] = r
+        json.dump(results, open(results_path, "w"), indent=1, sort_keys=True)
+    write_table(results)
+    plots(results)
+
+
+def write_table(results):
+    lines = ["| scene | ref noise | " + " | ".join(l for l, _, _ in CONFIGS[:1] + CONFIGS[10:11]) +
+             " | mfs time [s] | pathtrace equal-error time [s] | speed-up |", "|---|---|---|---|---|---|---|"]
+    for name in suite():
+        if name not in results:
+            continue
+        r = results[name]
+        m, o = r["configs"]["mfs"], r["configs"]["octave"]
+        eq = m.get("pathtrace_equal_error_time_s")
+        lines.append(f"| {name} | {r['reference_noise_rel_rmse']:.1%} | {m['mean_error']:+.1%} / {m['rel_rmse']:.1%} | "
+                     f"{o['mean_error']:+.1%} / {o['rel_rmse']:.1%} | {m['time_s']:.2f} | " +
+                     ("- | - |" if eq is None else f"{eq:.1f} | {m['speedup']:.1f}x |"))
+    lines += ["", "All configurations (mean error / rel RMSE):", "",
+              "| scene | " + " | ".join(l for l, _, _ in CONFIGS) + " |", "|---" * (len(CONFIGS) + 1) + "|"]
+    for name in suite():
+        if name not in results:
+            continue
+        cs = results[name]["configs"]
+        lines.append(f"| {name} | " + " | ".join(
+            f"{cs[l]['mean_error']:+.0%} / {cs[l]['rel_rmse']:.0%}" if l in cs else "-" for l, _, _ in CONFIGS) + " |")
+    open(os.path.join(DOCS, "render_table.md"), "w").write("\n".join(lines) + "\n")
+    print("\n".join(lines))
+
+
+def plots(results):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import matplotlib.image as mpimg
+    names = [n for n in suite() if n in results]
+    cols = ["reference", "mfs", "octave", "single", "mfs_error"]
+    fig, axes = plt.subplots(len(names), len(cols), figsize=(2.0 * len(cols), 2.0 * len(names)), squeeze=False)
+    for i, n in enumerate(names):
+        for j, c in enumerate(cols):
+            ax = axes[i][j]
+            ax.axis("off")
+            p = os.path.join(IMG, f"{n}_{c}.png")
+            if os.path.exists(p):
+                ax.imshow(mpimg.imread(p), interpolation="nearest")
+            if i == 0:
+                ax.set_title(c.replace("_", " "), fontsize=9)
+        axes[i][0].text(-0.05, 0.5, n.replace("_", "\n", 1), transform=axes[i][0].transAxes, ha="right",
+                        va="center", fontsize=6)
+    fig.tight_layout()
+    fig.savefig(os.path.join(DOCS, "render_suite.png"), dpi=90)
+    plt.close(fig)
+
+    cols = 4
+    rows = math.ceil(len(names) / cols)
+    fig, axes = plt.subplots(rows, cols, figsize=(4 * cols, 3.2 * rows), squeeze=False)
+    for k, n in enumerate(names):
+        ax = axes[k // cols][k % cols]
+        r = results[n]
+        pt = r["pathtrace"]
+        ax.loglog([p["time_s"] for p in pt], [p["rel_rmse"] for p in pt], "k-o", label="pathtrace", ms=3)
+        for label, mk in (("mfs", "o"), ("mfs K=1", "s"), ("octave", "^"), ("single", "v")):
+            c = r["configs"][label]
+            ax.loglog([c["time_s"]], [c["rel_rmse"]], mk, label=label)
+        ax.axhline(r["reference_noise_rel_rmse"], color="gray", lw=0.5, ls="--")
+        ax.set_title(n, fontsize=8)
+        ax.set_xlabel("time [s]", fontsize=7)
+        ax.set_ylabel("rel RMSE", fontsize=7)
+        ax.tick_params(labelsize=6)
+        if k == 0:
+            ax.legend(fontsize=6)
+    for k in range(len(names), rows * cols):
+        axes[k // cols][k % cols].axis("off")
+    fig.tight_layout()
+    fig.savefig(os.path.join(DOCS, "render_error_time.png"), dpi=90)
+    plt.close(fig)
 
 
 if __name__ == "__main__":

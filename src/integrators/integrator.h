@@ -20,8 +20,8 @@ struct SceneContext {
   SceneMedia media;
   MajorantGrid majorants;
   PinholeCamera camera;
-  std::vector<Light> lights;     // directional and point lights (sampled by NEE)
-  Rgb environment{0.0};          // sum of environment lights' radiance
+  std::vector<Light> lights;  // directional and point lights (sampled by NEE)
+  Rgb environment{0.0};       // sum of environment lights' radiance
   bool has_environment = false;
 };
 
@@ -33,7 +33,8 @@ class Integrator {
 };
 
 // Checks the integrator-specific fields of a scene's integrator block (errors name `where`).
-void validate_integrator_options(const std::string& type, const nlohmann::json& options, const std::string& where);
+void validate_integrator_options(const std::string& type, const nlohmann::json& options,
+                                 const std::string& where);
 
 std::unique_ptr<Integrator> make_integrator(const std::string& type, const IntegratorSettings& settings,
                                             const SceneContext& context);

@@ -37,6 +37,18 @@ MfsSettings parse_mfs_settings(const nlohmann::json& options, const std::string&
   s.grid.max_wide_scatters = s.large_angle_scatters;
   s.grid.photons = int(o.integer("photons", 1, 1 << 26, s.grid.photons));
   s.grid.resolution = int(o.integer("scatter_grid_resolution", 4, 96, s.grid.resolution));
+  s.grid.bands = int(o.integer("scatter_grid_bands", 2, 3, s.grid.bands));
+  const std::string transport = o.string("photon_transport", "exact");
+  if (transport != "similarity" && transport != "exact")
+    o.fail("photon_transport", "must be \"similarity\" or \"exact\"");
+  s.grid.exact_transport = transport == "exact";
+  const std::string side = o.string("forward_side", "camera");
+  if (side != "camera" && side != "light") o.fail("forward_side", "must be \"camera\" or \"light\"");
+  s.light_side = side == "light";
+  if (s.light_side) {
+    s.forward_light_path = true;
+    s.grid.exact_transport = true;
+  }
   s.shadow_map_resolution = int(o.integer("shadow_map_resolution", 8, 1024, s.shadow_map_resolution));
   if (strict) o.finish();
   return s;
@@ -62,6 +74,13 @@ MfsIntegrator::MfsIntegrator(const SceneContext& context, MfsSettings settings)
   }
 }
 
+size_t MfsIntegrator::memory_bytes() const {
+  size_t bytes = grid_ ? grid_->memory_bytes() : 0;
+  for (const auto& m : full_maps_) bytes += m.memory_bytes();
+  for (const auto& m : reduced_maps_) bytes += m.memory_bytes();
+  return bytes;
+}
+
 Rgb MfsIntegrator::sample(double px, double py, Rng& rng) const {
   return radiance(ctx_.camera.origin(), ctx_.camera.direction(px, py), rng);
 }
@@ -80,7 +99,8 @@ Rgb MfsIntegrator::radiance(const Vec3& o, const Vec3& d, Rng& rng) const {
           const Rgb sigma_red = mp.sigma_t() - sigma_peak;
           if (max_component(mp.sigma_s) > 0.0) {
             // Camera-side depths at the sample point.
-            const Rgb T_here = T_red * exp(-sigma_red * (jitter * dt));
+            const Rgb T_here = s_.light_side ? T_full * exp(-mp.sigma_t() * (jitter * dt))
+                                             : T_red * exp(-sigma_red * (jitter * dt));
             const Rgb tp = tau_p + sigma_peak * (jitter * dt);
             Rgb in_scatter(0.0);
             for (int i = 0; i < mp.count; ++i) {
@@ -96,6 +116,17 @@ Rgb MfsIntegrator::radiance(const Vec3& o, const Vec3& d, Rng& rng) const {
                 const double mu = dot(d, ls.wi);
                 const Rgb T_light = full_maps_[l].lookup(p);
                 const Rgb T_wide = s_.forward_light_path ? reduced_maps_[l].lookup(p) : T_light;
+                if (s_.light_side) {
+                  // The light's peak-only (zero wide scatter) beam at p: total T_wide, spread by the
+                  // light-side peak depth ln(T_wide / T_light); scattered by the whole phase function.
+                  for (int c = 0; c < 3; ++c) {
+                    const double tps = T_light[c] > 1e-30 ? std::max(0.0, std::log(T_wide[c] / T_light[c]))
+                                                          : PhaseSplit::kTauMax;
+                    Li[c] += ls.weight[c] * T_wide[c] *
+                             ((1.0 - f) * split.wide_eff(tps, mu) + f * split.peak_eff(tps, mu));
+                  }
+                  continue;
+                }
                 for (int c = 0; c < 3; ++c)
                   Li[c] += ls.weight[c] * ((1.0 - f) * split.wide_eff(tp[c], mu) * T_wide[c] +
                                            f * split.peak_eff(tp[c], mu) * T_light[c]);
@@ -105,7 +136,11 @@ Rgb MfsIntegrator::radiance(const Vec3& o, const Vec3& d, Rng& rng) const {
                 const double u1 = rng.uniform(), u2 = rng.uniform();
                 const Vec3 wi = phase_sample(ctx_.media.phase(i), d, u1, u2);
                 const double mu = dot(d, wi), pdf = phase_eval(ctx_.media.phase(i), mu);
-                if (pdf > 0.0) {
+                if (pdf > 0.0 && s_.light_side) {
+                  Li += ctx_.environment *
+                        ratio_tracking(ctx_.majorants, p, wi, std::numeric_limits<double>::infinity(), rng,
+                                       [&](const Vec3& x) { return reduced_sigma_t(ctx_.media, x, f_); });
+                } else if (pdf > 0.0) {
                   const Rgb T_light = ratio_tracking_transmittance(
                       ctx_.media, ctx_.majorants, p, wi, std::numeric_limits<double>::infinity(), rng);
                   const Rgb T_wide =
@@ -125,11 +160,28 @@ Rgb MfsIntegrator::radiance(const Vec3& o, const Vec3& d, Rng& rng) const {
               if (grid_) {
                 const std::vector<double>& chi_w = split.wide_moments();
                 const std::vector<double>& chi_p = split.peak_moments();
-                const double g_wide = chi_w.size() > 1 ? chi_w[1] : 0.0;
-                const double blur = chi_p.size() > 1 ? 1.0 - chi_p[1] : 0.0;
-                Rgb g;
-                for (int c = 0; c < 3; ++c) g[c] = g_wide * std::exp(-tp[c] * blur);
-                Li += (1.0 - f) * grid_->scattered(p, -d, g);
+                // The wide part's Legendre moments after the camera-side peak blur.
+                auto chi = [&](size_t l, double tau) {
+                  if (chi_w.size() <= l) return 0.0;
+                  return chi_w[l] * std::exp(-tau * (chi_p.size() > l ? 1.0 - chi_p[l] : 0.0));
+                };
+                Rgb chi1, chi2;
+                for (int c = 0; c < 3; ++c) {
+                  chi1[c] = chi(1, tp[c]);
+                  chi2[c] = chi(2, tp[c]);
+                }
+                if (s_.light_side) {
+                  // Every scatter at p (whole phase function), no camera-side blur: the camera leg is exact.
+                  for (int c = 0; c < 3; ++c) {
+                    chi1[c] = f * (chi_p.size() > 1 ? chi_p[1] : 1.0) +
+                              (1.0 - f) * (chi_w.size() > 1 ? chi_w[1] : 0.0);
+                    chi2[c] = f * (chi_p.size() > 2 ? chi_p[2] : 1.0) +
+                              (1.0 - f) * (chi_w.size() > 2 ? chi_w[2] : 0.0);
+                  }
+                  Li += grid_->scattered(p, -d, chi1, chi2);
+                } else {
+                  Li += (1.0 - f) * grid_->scattered(p, -d, chi1, chi2);
+                }
               }
               in_scatter += mp.sigma_s_i[i] * Li;
             }
@@ -138,7 +190,7 @@ Rgb MfsIntegrator::radiance(const Vec3& o, const Vec3& d, Rng& rng) const {
           T_full *= exp(-mp.sigma_t() * dt);
           T_red *= exp(-sigma_red * dt);
           tau_p += sigma_peak * dt;
-          return max_component(T_red) > 1e-6;
+          return max_component(s_.light_side ? T_full : T_red) > 1e-6;
         });
   if (ctx_.has_environment) L += T_full * ctx_.environment;
   return L;

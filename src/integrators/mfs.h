@@ -40,6 +40,7 @@ struct MfsSettings {
   bool forward_light_path = true;  // light_path: "forward" (true) or "beer_lambert"
   bool gaussian = false;           // propagator: "gsa" (false) or "gaussian" (Gaussian stand-in for the peak)
   double peak_fraction = -1.0;     // f in [0, 0.99]; < 0: "auto" (g^2 per medium)
+  bool light_side = false;       // forward_side "light": peak scatters on the light's side, exact camera leg
   int large_angle_scatters = 0;    // K: at most K wide scatters per path; 0 = "all"
   int shadow_map_resolution = 64;
   ScatterGridSettings grid;  // the higher orders (K != 1): photons, resolution; seed from the scene
@@ -55,6 +56,8 @@ class MfsIntegrator final : public Integrator {
   Rgb radiance(const Vec3& o, const Vec3& d, Rng& rng) const;
   const PhaseSplit& split(int medium) const { return *splits_[medium]; }
   const ScatterGrid* scatter_grid() const { return grid_.get(); }
+  // Bytes held by the deep shadow maps and the scatter grid.
+  size_t memory_bytes() const;
 
  private:
   const SceneContext& ctx_;

@@ -43,37 +43,38 @@ Rgb PathTracer::radiance(const Vec3& origin, const Vec3& direction, Rng& rng) co
     Vec3 scatter_p;
     const bool escaped = track(ctx_.majorants, o, d, std::numeric_limits<double>::infinity(), rng,
                                [&](const Vec3& p, double maj) {
-      ctx_.media.eval(p, &mp);
-      const Rgb sigma_n = Rgb(maj) - mp.sigma_t();
-      // Event probabilities from throughput-weighted channel sums (history-aware spectral tracking,
-      // which keeps the per-channel weights bounded); absorption is carried as weight, not sampled.
-      const double p_null = std::max(0.0, dot(beta, sigma_n));
-      double p_scatter = 0.0;
-      for (int i = 0; i < mp.count; ++i) p_scatter += dot(beta, mp.sigma_s_i[i]);
-      const double total = p_null + p_scatter;
-      if (total <= 0.0) {  // pure absorber at the majorant: the path ends here
-        beta = Rgb(0.0);
-        return false;
-      }
-      double u = rng.uniform() * total;
-      if (u < p_null) {
-        beta *= sigma_n * (total / (maj * p_null));
-        return true;
-      }
-      u -= p_null;
-      for (int i = 0; i < mp.count; ++i) {
-        const double pi = dot(beta, mp.sigma_s_i[i]);
-        if (pi <= 0.0) continue;
-        if (u < pi || i == mp.count - 1) {
-          beta *= mp.sigma_s_i[i] * (total / (maj * pi));
-          scatter_medium = i;
-          scatter_p = p;
-          return false;
-        }
-        u -= pi;
-      }
-      return false;
-    });
+                                 ctx_.media.eval(p, &mp);
+                                 const Rgb sigma_n = Rgb(maj) - mp.sigma_t();
+                                 // Event probabilities from throughput-weighted channel sums (history-aware
+                                 // spectral tracking, which keeps the per-channel weights bounded);
+                                 // absorption is carried as weight, not sampled.
+                                 const double p_null = std::max(0.0, dot(beta, sigma_n));
+                                 double p_scatter = 0.0;
+                                 for (int i = 0; i < mp.count; ++i) p_scatter += dot(beta, mp.sigma_s_i[i]);
+                                 const double total = p_null + p_scatter;
+                                 if (total <= 0.0) {  // pure absorber at the majorant: the path ends here
+                                   beta = Rgb(0.0);
+                                   return false;
+                                 }
+                                 double u = rng.uniform() * total;
+                                 if (u < p_null) {
+                                   beta *= sigma_n * (total / (maj * p_null));
+                                   return true;
+                                 }
+                                 u -= p_null;
+                                 for (int i = 0; i < mp.count; ++i) {
+                                   const double pi = dot(beta, mp.sigma_s_i[i]);
+                                   if (pi <= 0.0) continue;
+                                   if (u < pi || i == mp.count - 1) {
+                                     beta *= mp.sigma_s_i[i] * (total / (maj * pi));
+                                     scatter_medium = i;
+                                     scatter_p = p;
+                                     return false;
+                                   }
+                                   u -= pi;
+                                 }
+                                 return false;
+                               });
     if (escaped) {
       // Only camera rays see the environment directly; later escapes were counted by NEE.
       if (events == 0 && ctx_.has_environment) L += beta * ctx_.environment;

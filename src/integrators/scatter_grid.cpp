@@ -11,8 +11,24 @@ namespace nimbus {
 namespace {
 
 constexpr int kBatches = 8;             // fixed: the grid must not depend on the thread count
-constexpr int kMaxWideScatters = 1024;  // photons are ended after this many wide scatters
-constexpr int kFloatsPerNode = 12;
+constexpr int kMaxWideScatters = 1024;  // photons are ended after this many wide scatters ...
+constexpr int kMaxEvents = 1 << 20;     // ... or real collisions
+constexpr int kCoeffs = 9;              // real spherical harmonics, bands l = 0, 1, 2
+constexpr int kFloatsPerNode = 3 * kCoeffs;
+constexpr int kBand[kCoeffs] = {0, 1, 1, 1, 2, 2, 2, 2, 2};
+
+// The real spherical harmonics Y_lm(w), l <= 2, of a unit vector.
+void sh9(const Vec3& w, double* y) {
+  y[0] = 0.28209479177387814;
+  y[1] = 0.4886025119029199 * w.y;
+  y[2] = 0.4886025119029199 * w.z;
+  y[3] = 0.4886025119029199 * w.x;
+  y[4] = 1.0925484305920792 * w.x * w.y;
+  y[5] = 1.0925484305920792 * w.y * w.z;
+  y[6] = 0.31539156525252005 * (3.0 * w.z * w.z - 1.0);
+  y[7] = 1.0925484305920792 * w.x * w.z;
+  y[8] = 0.5462742152960396 * (w.x * w.x - w.y * w.y);
+}
 
 struct Photon {
   Vec3 x, w;
@@ -80,6 +96,7 @@ ScatterGrid::ScatterGrid(const SceneContext& ctx, const std::vector<const PhaseS
     bounds_.lo[a] = media_bounds.lo[a] - spacing_[a];
     bounds_.hi[a] = bounds_.lo[a] + spacing_[a] * (nodes_[a] - 1);
   }
+  bands_ = s.bands;
   const size_t node_count = size_t(nodes_[0]) * nodes_[1] * nodes_[2];
   values_.assign(node_count * kFloatsPerNode, 0.0f);
   if (s.max_wide_scatters == 1) return;  // nothing beyond the first wide scatter
@@ -109,8 +126,8 @@ ScatterGrid::ScatterGrid(const SceneContext& ctx, const std::vector<const PhaseS
   tbb::parallel_for(0, kBatches, [&](int b) {
     std::vector<float>& g = batch[b];
     g.assign(node_count * kFloatsPerNode, 0.0f);
-    // Splat value `v` (per channel; only channels with a non-zero entry) with direction w at q.
-    auto splat = [&](const Vec3& q, const Vec3& w, const Rgb& v) {
+    // Splat value `v` (per channel; only channels with a non-zero entry) times the harmonics y at q.
+    auto splat = [&](const Vec3& q, const double* y, const Rgb& v) {
       int i[3];
       double fr[3];
       for (int a = 0; a < 3; ++a) {
@@ -127,10 +144,7 @@ ScatterGrid::ScatterGrid(const SceneContext& ctx, const std::vector<const PhaseS
         for (int c = 0; c < 3; ++c) {
           if (v[c] == 0.0) continue;
           const double e = wt * v[c];
-          node[4 * c + 0] += float(e);
-          node[4 * c + 1] += float(e * w.x);
-          node[4 * c + 2] += float(e * w.y);
-          node[4 * c + 3] += float(e * w.z);
+          for (int h = 0; h < kCoeffs; ++h) node[kCoeffs * c + h] += float(e * y[h]);
         }
       }
     };
@@ -142,7 +156,9 @@ ScatterGrid::ScatterGrid(const SceneContext& ctx, const std::vector<const PhaseS
       if (!(len > 0.0)) return;
       const int n = std::max(1, int(std::ceil(len / (0.5 * h_min))));
       const Rgb v = power * (len / n);
-      for (int k = 0; k < n; ++k) splat(x + w * (t0 + (k + 0.5) * len / n), w, v);
+      double y[kCoeffs];
+      sh9(w, y);
+      for (int k = 0; k < n; ++k) splat(x + w * (t0 + (k + 0.5) * len / n), y, v);
     };
 
     const size_t begin = total * size_t(b) / kBatches, end = total * size_t(b + 1) / kBatches;
@@ -160,12 +176,15 @@ ScatterGrid::ScatterGrid(const SceneContext& ctx, const std::vector<const PhaseS
       if (max_component(power) <= 0.0) continue;
       Vec3 x = ph.x, w = ph.w;
       double weight = 1.0;
-      for (int order = 0;; ++order) {
+      int order = 0;  // wide scatters so far
+      for (int events = 0; events < kMaxEvents; ++events) {
         bool hit = false;
         Vec3 xc;
         track(ctx.majorants, x, w, std::numeric_limits<double>::infinity(), rng,
               [&](const Vec3& p, double maj) {
-                if (rng.uniform() * maj < reduced_sigma_t(ctx.media, p, peak_fraction)[c]) {
+                const double sigma = s.exact_transport ? ctx.media.sigma_t(p)[c]
+                                                       : reduced_sigma_t(ctx.media, p, peak_fraction)[c];
+                if (rng.uniform() * maj < sigma) {
                   hit = true;
                   xc = p;
                   return false;
@@ -174,40 +193,50 @@ ScatterGrid::ScatterGrid(const SceneContext& ctx, const std::vector<const PhaseS
               });
         if (order >= 1)
           deposit(x, w, hit ? (xc - x).length() : std::numeric_limits<double>::infinity(), power * weight);
-        if (!hit || order + 1 >= K) break;
-        // A wide scatter at xc (or absorption): albedo weight, roulette, medium, direction.
+        if (!hit) break;
+        // A real collision at xc: albedo weight, roulette, medium, direction.
         ctx.media.eval(xc, &mp);
-        double wide[kMaxMedia], wide_sum = 0.0;
+        double part[kMaxMedia], part_sum = 0.0;
         for (int i = 0; i < mp.count && i < media_count; ++i) {
-          wide[i] = (1.0 - peak_fraction[i]) * mp.sigma_s_i[i][c];
-          wide_sum += wide[i];
+          part[i] = (s.exact_transport ? 1.0 : 1.0 - peak_fraction[i]) * mp.sigma_s_i[i][c];
+          part_sum += part[i];
         }
-        const double sigma_red = mp.sigma_a[c] + wide_sum;
-        if (!(wide_sum > 0.0) || !(sigma_red > 0.0)) break;
-        weight *= wide_sum / sigma_red;
+        const double sigma = mp.sigma_a[c] + part_sum;
+        if (!(part_sum > 0.0) || !(sigma > 0.0)) break;
+        weight *= part_sum / sigma;
         if (weight < 0.1) {
           if (rng.uniform() * 0.1 >= weight) break;
           weight = 0.1;
         }
-        double u = rng.uniform() * wide_sum;
+        double u = rng.uniform() * part_sum;
         int m = 0;
-        while (m + 1 < mp.count && u >= wide[m]) u -= wide[m++];
-        // P_wide by rejection from P: accept with (1 - f) P_wide / P (<= 1), expected 1 / (1 - f) tries.
+        while (m + 1 < mp.count && u >= part[m]) u -= part[m++];
         const Phase& phase = ctx.media.phase(m);
         const double f = peak_fraction[m];
-        Vec3 w_new = w;
-        for (int tries = 0; tries < 10000; ++tries) {
+        // The probability that a scatter into direction cosine mu is a wide one: (1 - f) P_wide / P.
+        auto wide_share = [&](double mu) {
+          const double p_full = phase_eval(phase, mu);
+          return p_full > 0.0 ? (1.0 - f) * splits[m]->wide(mu) / p_full : 1.0;
+        };
+        if (s.exact_transport) {
+          // The full phase function; the scatter counts as wide with its share.
           const double v1 = rng.uniform(), v2 = rng.uniform();
-          const Vec3 cand = phase_sample(phase, w, v1, v2);
-          const double mu = dot(cand, w), p_full = phase_eval(phase, mu);
-          const double accept = p_full > 0.0 ? (1.0 - f) * splits[m]->wide(mu) / p_full : 1.0;
-          if (rng.uniform() < accept) {
-            w_new = cand;
-            break;
+          const Vec3 w_new = phase_sample(phase, w, v1, v2);
+          if (rng.uniform() < wide_share(dot(w_new, w)) && ++order >= K) break;
+          w = w_new;
+        } else {
+          // Peak scatters are not events: draw P_wide by rejection from P (expected 1 / (1 - f) tries).
+          if (++order >= K) break;
+          for (int tries = 0; tries < 10000; ++tries) {
+            const double v1 = rng.uniform(), v2 = rng.uniform();
+            const Vec3 cand = phase_sample(phase, w, v1, v2);
+            if (rng.uniform() < wide_share(dot(cand, w))) {
+              w = cand;
+              break;
+            }
           }
         }
         x = xc;
-        w = w_new;
       }
     }
   });
@@ -223,9 +252,8 @@ ScatterGrid::ScatterGrid(const SceneContext& ctx, const std::vector<const PhaseS
   });
 }
 
-void ScatterGrid::lookup(const Vec3& p, Rgb* phi, std::array<Rgb, 3>* flux) const {
-  *phi = Rgb(0.0);
-  for (Rgb& f : *flux) f = Rgb(0.0);
+void ScatterGrid::lookup(const Vec3& p, std::array<double, 27>* coeffs) const {
+  coeffs->fill(0.0);
   if (!bounds_.contains(p)) return;
   int i[3];
   double fr[3];
@@ -239,21 +267,21 @@ void ScatterGrid::lookup(const Vec3& p, Rgb* phi, std::array<Rgb, 3>* flux) cons
     const double wt = (dx ? fr[0] : 1 - fr[0]) * (dy ? fr[1] : 1 - fr[1]) * (dz ? fr[2] : 1 - fr[2]);
     const float* node =
         &values_[((size_t(i[2] + dz) * nodes_[1] + i[1] + dy) * nodes_[0] + i[0] + dx) * kFloatsPerNode];
-    for (int c = 0; c < 3; ++c) {
-      (*phi)[c] += wt * node[4 * c];
-      for (int a = 0; a < 3; ++a) (*flux)[a][c] += wt * node[4 * c + 1 + a];
-    }
+    for (int h = 0; h < kFloatsPerNode; ++h) (*coeffs)[h] += wt * node[h];
   }
 }
 
-Rgb ScatterGrid::scattered(const Vec3& p, const Vec3& w_out, const Rgb& g) const {
-  Rgb phi;
-  std::array<Rgb, 3> flux;
-  lookup(p, &phi, &flux);
+Rgb ScatterGrid::scattered(const Vec3& p, const Vec3& w_out, const Rgb& chi1, const Rgb& chi2) const {
+  std::array<double, 27> L;
+  lookup(p, &L);
+  double y[kCoeffs];
+  sh9(w_out, y);
   Rgb r;
   for (int c = 0; c < 3; ++c) {
-    const double f_dot_w = flux[0][c] * w_out.x + flux[1][c] * w_out.y + flux[2][c] * w_out.z;
-    r[c] = std::max(0.0, (phi[c] + 3.0 * g[c] * f_dot_w) / (4.0 * kPi));
+    const double chi[3] = {1.0, chi1[c], bands_ > 2 ? chi2[c] : 0.0};
+    double v = 0.0;
+    for (int h = 0; h < kCoeffs; ++h) v += chi[kBand[h]] * L[kCoeffs * c + h] * y[h];
+    r[c] = std::max(0.0, v);
   }
   return r;
 }

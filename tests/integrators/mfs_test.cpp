@@ -162,6 +162,10 @@ TEST(Mfs, OptionsAreValidatedStrictly) {
   EXPECT_THROW(parse(R"({"peak_fraction": 1.5})"), Error);
   EXPECT_NO_THROW(parse(R"({"large_angle_scatters": 3, "photons": 1000, "scatter_grid_resolution": 16})"));
   EXPECT_NO_THROW(parse(R"({"large_angle_scatters": "all"})"));
+  EXPECT_NO_THROW(parse(R"({"photon_transport": "similarity", "forward_side": "light", "scatter_grid_bands": 2})"));
+  EXPECT_THROW(parse(R"({"photon_transport": "fast"})"), Error);
+  EXPECT_THROW(parse(R"({"forward_side": "both"})"), Error);
+  EXPECT_THROW(parse(R"({"scatter_grid_bands": 4})"), Error);
   EXPECT_THROW(parse(R"({"large_angle_scatters": 0})"), Error);
   EXPECT_THROW(parse(R"({"large_angle_scatters": "many"})"), Error);
   EXPECT_THROW(parse(R"({"photons": 0})"), Error);
@@ -247,9 +251,15 @@ TEST(Mfs, WhiteFurnaceWithAllOrders) {
                "phase": {"type": "hg", "g": 0.8}}],
     "lights": [{"type": "environment", "radiance": 1.0}],
     "integrator": {"type": "mfs", "spp": 4, "tau_step": 0.05}})");
-  const RenderResult r = render(scene, RenderOptions{});
-  const Rgb m = image_mean(r.image);
-  for (int c = 0; c < 3; ++c) EXPECT_NEAR(m[c], 1.0, 0.03) << c;
+  for (const char* side : {"camera", "light"}) {
+    for (const char* transport : {"exact", "similarity"}) {
+      scene.integrator.options["forward_side"] = side;
+      scene.integrator.options["photon_transport"] = transport;
+      const Rgb m = image_mean(render(scene, RenderOptions{}).image);
+      for (int c = 0; c < 3; ++c) EXPECT_NEAR(m[c], 1.0, 0.03) << side << " " << transport << " " << c;
+    }
+  }
+  scene.integrator.options.erase("forward_side");
   // With one wide scatter only the furnace is visibly dark.
   scene.integrator.options["large_angle_scatters"] = 1;
   EXPECT_LT(image_mean(render(scene, RenderOptions{}).image)[0], 0.9);
