@@ -10,7 +10,7 @@ chromatic coefficients, and the Disney cloud at two densities. For each scene:
     with reference >= 5 % of the mean (`nimbus compare --bin 4 --min-ref 0.05`), wall time;
   - pathtrace at 4, 16, 64 spp (error against time), from which the time path tracing needs to reach
     the rel RMSE of `mfs` is read off (rel RMSE ~ c / sqrt(spp)): the equal-error speed-up.
-Writes docs/validation/render_results.json, render_table.md (included in render.md by hand),
+Writes docs/validation/render_results.json, the tables in docs/validation/render.md (between markers),
 render_suite.png (reference | mfs | octave | single | mfs error) and render_error_time.png.
 
     nice validation/mfs_validation.py [--only NAME] [--scale 1.0]
@@ -119,11 +119,19 @@ def png(exr, out, exposure, heat_ref=None):
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--only")
+    ap.add_argument("--orders", action="store_true", help="only the order-by-order comparison")
+    ap.add_argument("--tables", action="store_true", help="only rewrite tables and plots from the results")
     args = ap.parse_args()
+    if args.orders:
+        os.makedirs(TMP, exist_ok=True)
+        return orders()
     os.makedirs(TMP, exist_ok=True)
     os.makedirs(IMG, exist_ok=True)
     results_path = os.path.join(DOCS, "render_results.json")
     results = json.load(open(results_path)) if os.path.exists(results_path) else {}
+    if args.tables:
+        write_table(results)
+        return plots(results)
     for name, (scene, base, ref_spp) in suite().items():
         if args.only and args.only not in name:
             continue
@@ -175,6 +183,47 @@ def main():
     plots(results)
 
 
+ORDER_SCENES = ["sphere_r2_a0.99_hg0.85_side", "sphere_r10_a0.99_hg0.85_side", "sphere_r10_a0.99_hg0.85_front",
+                "sphere_r10_a0.99_hg0.85_back", "sphere_r20_a0.9999_hg0.95_back", "disney_cloud"]
+
+
+def orders():
+    """mfs with K wide scatters against the path tracer limited to K wide scatters (the same split)."""
+    path = os.path.join(DOCS, "render_orders.json")
+    out = json.load(open(path)) if os.path.exists(path) else {}
+    all_scenes = suite()
+    for name in ORDER_SCENES:
+        scene, base, ref_spp = all_scenes[name]
+        out[name] = {}
+        for K in (1, 2, 3):
+            ref = os.path.join(REFS, f"{name}_wide{K}_pt{ref_spp // 2}.exr")
+            if not os.path.exists(ref):
+                render(scene, base, {"type": "pathtrace", "max_wide_scatters": K}, ref_spp // 2, ref)
+            res = {}
+            for label, block in (("camera side", {"type": "mfs"}), ("light side", {"type": "mfs", "forward_side": "light"})):
+                img = os.path.join(TMP, f"{name}_K{K}_{label.replace(' ', '_')}.exr")
+                render(scene, base, dict(block, large_angle_scatters=K), 4, img)
+                mean, rrmse, _ = compare(img, ref)
+                res[label] = {"mean_error": mean, "rel_rmse": rrmse}
+                print(f"{name:34s} K={K} {label:12s} mean {mean:+.3f} rrmse {rrmse:.3f}", flush=True)
+            out[name][str(K)] = res
+        json.dump(out, open(path, "w"), indent=1, sort_keys=True)
+    lines = ["| scene | K | camera side: mean / rel RMSE | light side: mean / rel RMSE |", "|---|---|---|---|"]
+    for name, byk in out.items():
+        for K, res in sorted(byk.items()):
+            c, l = res["camera side"], res["light side"]
+            lines.append(f"| {name} | {K} | {c['mean_error']:+.1%} / {c['rel_rmse']:.1%} | "
+                         f"{l['mean_error']:+.1%} / {l['rel_rmse']:.1%} |")
+    text = "\n".join(lines)
+    print(text)
+    doc = os.path.join(DOCS, "render.md")
+    if os.path.exists(doc):
+        d = open(doc).read()
+        a, b = d.find("<!-- orders -->"), d.find("<!-- /orders -->")
+        if a >= 0 and b > a:
+            open(doc, "w").write(d[:a] + "<!-- orders -->\n" + text + "\n" + d[b:])
+
+
 def write_table(results):
     lines = ["| scene | ref noise | " + " | ".join(l for l, _, _ in CONFIGS[:1] + CONFIGS[10:11]) +
              " | mfs time [s] | pathtrace equal-error time [s] | speed-up |", "|---|---|---|---|---|---|---|"]
@@ -195,8 +244,15 @@ def write_table(results):
         cs = results[name]["configs"]
         lines.append(f"| {name} | " + " | ".join(
             f"{cs[l]['mean_error']:+.0%} / {cs[l]['rel_rmse']:.0%}" if l in cs else "-" for l, _, _ in CONFIGS) + " |")
-    open(os.path.join(DOCS, "render_table.md"), "w").write("\n".join(lines) + "\n")
-    print("\n".join(lines))
+    text = "\n".join(lines)
+    print(text)
+    # Between the markers of docs/validation/render.md.
+    doc = os.path.join(DOCS, "render.md")
+    if os.path.exists(doc):
+        d = open(doc).read()
+        a, b = d.find("<!-- table -->"), d.find("<!-- /table -->")
+        if a >= 0 and b > a:
+            open(doc, "w").write(d[:a] + "<!-- table -->\n" + text + "\n" + d[b:])
 
 
 def plots(results):

@@ -25,7 +25,9 @@ SceneContext::SceneContext(const Scene& scene, int majorant_resolution, bool glo
 
 void validate_integrator_options(const std::string& type, const nlohmann::json& options,
                                  const std::string& where) {
-  if (type == "single") {
+  if (type == "pathtrace") {
+    parse_pathtrace_settings(options, where, true);
+  } else if (type == "single") {
     parse_single_settings(options, where, true);
   } else if (type == "mfs") {
     parse_mfs_settings(options, where, true);
@@ -39,7 +41,9 @@ void validate_integrator_options(const std::string& type, const nlohmann::json& 
 
 std::unique_ptr<Integrator> make_integrator(const std::string& type, const IntegratorSettings& settings,
                                             const SceneContext& context) {
-  if (type == "pathtrace") return std::make_unique<PathTracer>(context, settings.max_events);
+  if (type == "pathtrace")
+    return std::make_unique<PathTracer>(context, settings.max_events,
+                                        parse_pathtrace_settings(settings.options, "scene", false));
   if (type == "single")
     return std::make_unique<SingleScatter>(context, parse_single_settings(settings.options, "scene", false));
   if (type == "mfs")

@@ -67,7 +67,7 @@ MfsIntegrator::MfsIntegrator(const SceneContext& context, MfsSettings settings)
     if (s_.forward_light_path)
       reduced_maps_.emplace_back(ctx_.media, ctx_.majorants, l, s_.shadow_map_resolution, 0.05, f_);
   }
-  if (s_.large_angle_scatters != 1) {
+  if (s_.large_angle_scatters != 1 || ctx_.has_environment) {
     std::vector<const PhaseSplit*> splits;
     for (const auto& sp : splits_) splits.push_back(sp.get());
     grid_ = std::make_unique<ScatterGrid>(ctx_, splits, f_, s_.grid);
@@ -131,32 +131,8 @@ Rgb MfsIntegrator::radiance(const Vec3& o, const Vec3& d, Rng& rng) const {
                   Li[c] += ls.weight[c] * ((1.0 - f) * split.wide_eff(tp[c], mu) * T_wide[c] +
                                            f * split.peak_eff(tp[c], mu) * T_light[c]);
               }
-              // The environment through one phase-sampled direction (weight P_eff / P).
-              if (ctx_.has_environment) {
-                const double u1 = rng.uniform(), u2 = rng.uniform();
-                const Vec3 wi = phase_sample(ctx_.media.phase(i), d, u1, u2);
-                const double mu = dot(d, wi), pdf = phase_eval(ctx_.media.phase(i), mu);
-                if (pdf > 0.0 && s_.light_side) {
-                  Li += ctx_.environment *
-                        ratio_tracking(ctx_.majorants, p, wi, std::numeric_limits<double>::infinity(), rng,
-                                       [&](const Vec3& x) { return reduced_sigma_t(ctx_.media, x, f_); });
-                } else if (pdf > 0.0) {
-                  const Rgb T_light = ratio_tracking_transmittance(
-                      ctx_.media, ctx_.majorants, p, wi, std::numeric_limits<double>::infinity(), rng);
-                  const Rgb T_wide =
-                      s_.forward_light_path
-                          ? ratio_tracking(ctx_.majorants, p, wi, std::numeric_limits<double>::infinity(),
-                                           rng,
-                                           [&](const Vec3& x) { return reduced_sigma_t(ctx_.media, x, f_); })
-                          : T_light;
-                  for (int c = 0; c < 3; ++c)
-                    Li[c] += ctx_.environment[c] *
-                             ((1.0 - f) * split.wide_eff(tp[c], mu) * T_wide[c] +
-                              f * split.peak_eff(tp[c], mu) * T_light[c]) /
-                             pdf;
-                }
-              }
-              // Light that already took wide scatters: its last wide scatter is here.
+              // Light that already took wide scatters (and the environment's light): its last wide scatter
+              // is here.
               if (grid_) {
                 const std::vector<double>& chi_w = split.wide_moments();
                 const std::vector<double>& chi_p = split.peak_moments();
@@ -192,7 +168,9 @@ Rgb MfsIntegrator::radiance(const Vec3& o, const Vec3& d, Rng& rng) const {
           tau_p += sigma_peak * dt;
           return max_component(s_.light_side ? T_full : T_red) > 1e-6;
         });
-  if (ctx_.has_environment) L += T_full * ctx_.environment;
+  // The environment behind the medium; its scattered light is in the grid. Camera side: its peak-scattered
+  // light stays on the ray (smooth in angle), so it is attenuated by the reduced extinction only.
+  if (ctx_.has_environment) L += (s_.light_side ? T_full : T_red) * ctx_.environment;
   return L;
 }
 

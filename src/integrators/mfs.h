@@ -19,8 +19,8 @@
 // (integrators/scatter_grid.h) and takes its last wide scatter at y:
 //     sigma_s (1 - f) (phi + 3 g_wide_eff(tau_p) F . w_o) / (4 pi)
 // with g_wide_eff = g_wide exp(-tau_p (1 - chi_1^peak)) (the camera-side peak blur of its mean cosine).
-// Light transmittances come from deep shadow maps (deterministic). The environment is sampled through
-// the phase function with ratio tracking (reduced extinction for the wide part), as `single` does.
+// Light transmittances come from deep shadow maps (deterministic). The environment (smooth in angle) is
+// carried by the scatter grid from its entry, so the camera ray needs no environment sampling.
 // Every channel uses its own optical depths; overlapping media share one tau_p (sum of f_i sigma_s_i).
 #pragma once
 

@@ -1,15 +1,48 @@
 #include "integrators/pathtrace.h"
 
 #include "integrators/tracking.h"
+#include "io/json_reader.h"
 #include "render/lights.h"
 
 namespace nimbus {
+
+PathTraceSettings parse_pathtrace_settings(const nlohmann::json& options, const std::string& where, bool strict) {
+  PathTraceSettings s;
+  JsonObject o(options, where, "/integrator");
+  s.max_wide_scatters = int(o.integer("max_wide_scatters", 0, 1 << 20, -1));
+  if (o.has("peak_fraction") && o.raw("peak_fraction").is_string()) {
+    if (o.string("peak_fraction") != "auto") o.fail("peak_fraction", "must be \"auto\" or a number in [0, 0.99]");
+  } else {
+    s.peak_fraction = o.number("peak_fraction", 0.0, 0.99, -1.0);
+  }
+  if (strict) o.finish();
+  return s;
+}
+
+PathTracer::PathTracer(const SceneContext& context, int max_events, PathTraceSettings settings)
+    : ctx_(context), max_events_(max_events), s_(settings) {
+  if (s_.max_wide_scatters < 0) return;
+  for (int i = 0; i < ctx_.media.count(); ++i) {
+    const Phase& phase = ctx_.media.phase(i);
+    const double f = s_.peak_fraction < 0.0 ? std::min(0.99, auto_peak_fraction(phase)) : s_.peak_fraction;
+    splits_.push_back(std::make_unique<PhaseSplit>(phase, f));
+  }
+}
+
+double PathTracer::split_weight(int medium, double mu, int wide) const {
+  if (splits_.empty()) return 1.0;
+  const PhaseSplit& split = *splits_[medium];
+  const double p = phase_eval(ctx_.media.phase(medium), mu);
+  const double share = p > 0.0 ? std::clamp((1.0 - split.f()) * split.wide(mu) / p, 0.0, 1.0) : 1.0;
+  const int K = s_.max_wide_scatters;
+  return (wide + 1 <= K ? share : 0.0) + (wide <= K ? 1.0 - share : 0.0);
+}
 
 Rgb PathTracer::sample(double px, double py, Rng& rng) const {
   return radiance(ctx_.camera.origin(), ctx_.camera.direction(px, py), rng);
 }
 
-Rgb PathTracer::direct_light(const Vec3& p, const Vec3& d, int medium, Rng& rng) const {
+Rgb PathTracer::direct_light(const Vec3& p, const Vec3& d, int medium, int wide_scatters, Rng& rng) const {
   const Phase& phase = ctx_.media.phase(medium);
   Rgb L(0.0);
   // Lights with a sampled direction: weight = radiance / pdf.
@@ -17,7 +50,7 @@ Rgb PathTracer::direct_light(const Vec3& p, const Vec3& d, int medium, Rng& rng)
     LightSample ls;
     const double u1 = rng.uniform(), u2 = rng.uniform();
     if (!sample_light(light, p, u1, u2, &ls)) continue;
-    const double f = phase_eval(phase, dot(d, ls.wi));
+    const double f = phase_eval(phase, dot(d, ls.wi)) * split_weight(medium, dot(d, ls.wi), wide_scatters);
     if (f <= 0.0) continue;
     const Rgb T = ratio_tracking_transmittance(ctx_.media, ctx_.majorants, p, ls.wi, ls.distance, rng);
     L += ls.weight * T * f;
@@ -28,7 +61,7 @@ Rgb PathTracer::direct_light(const Vec3& p, const Vec3& d, int medium, Rng& rng)
     const Vec3 wi = phase_sample(phase, d, u1, u2);
     const Rgb T = ratio_tracking_transmittance(ctx_.media, ctx_.majorants, p, wi,
                                                std::numeric_limits<double>::infinity(), rng);
-    L += ctx_.environment * T;
+    L += ctx_.environment * T * split_weight(medium, dot(d, wi), wide_scatters);
   }
   return L;
 }
@@ -36,6 +69,7 @@ Rgb PathTracer::direct_light(const Vec3& p, const Vec3& d, int medium, Rng& rng)
 Rgb PathTracer::radiance(const Vec3& origin, const Vec3& direction, Rng& rng) const {
   Rgb L(0.0), beta(1.0);
   Vec3 o = origin, d = direction;
+  int wide = 0;  // wide scatters so far (with a wide-scatter limit)
   MediumPoint mp;
   for (int events = 0;; ++events) {
     // Delta tracking to the next real scattering event.
@@ -83,12 +117,20 @@ Rgb PathTracer::radiance(const Vec3& origin, const Vec3& direction, Rng& rng) co
     if (scatter_medium < 0 || max_component(beta) <= 0.0) break;
 
     // Next-event estimation at the scattering vertex.
-    L += beta * direct_light(scatter_p, d, scatter_medium, rng);
+    L += beta * direct_light(scatter_p, d, scatter_medium, wide, rng);
     if (max_events_ > 0 && events + 1 >= max_events_) break;
 
     // Continue in a phase-sampled direction (weight f / pdf = 1).
     const double u1 = rng.uniform(), u2 = rng.uniform();
-    d = phase_sample(ctx_.media.phase(scatter_medium), d, u1, u2);
+    const Vec3 d_new = phase_sample(ctx_.media.phase(scatter_medium), d, u1, u2);
+    if (!splits_.empty()) {
+      // Classify the scatter (probability = its wide share); paths over the limit end here.
+      const PhaseSplit& split = *splits_[scatter_medium];
+      const double mu = dot(d, d_new), p = phase_eval(ctx_.media.phase(scatter_medium), mu);
+      const double share = p > 0.0 ? (1.0 - split.f()) * split.wide(mu) / p : 1.0;
+      if (rng.uniform() < share && ++wide > s_.max_wide_scatters) break;
+    }
+    d = d_new;
     o = scatter_p;
 
     // Russian roulette on the largest channel of the throughput.

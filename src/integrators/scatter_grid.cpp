@@ -99,7 +99,8 @@ ScatterGrid::ScatterGrid(const SceneContext& ctx, const std::vector<const PhaseS
   bands_ = s.bands;
   const size_t node_count = size_t(nodes_[0]) * nodes_[1] * nodes_[2];
   values_.assign(node_count * kFloatsPerNode, 0.0f);
-  if (s.max_wide_scatters == 1) return;  // nothing beyond the first wide scatter
+  // With K = 1 only the environment's unscattered-by-wide light is needed (see the header).
+  if (s.max_wide_scatters == 1 && !ctx.has_environment) return;
 
   // Grey media (every coefficient equal in all channels) take one pass carrying RGB power; otherwise
   // one pass per channel with that channel's coefficients.
@@ -110,7 +111,8 @@ ScatterGrid::ScatterGrid(const SceneContext& ctx, const std::vector<const PhaseS
            m.sigma_a.y == m.sigma_a.z;
   }
   const int passes = grey ? 1 : 3;
-  const size_t sources = ctx.lights.size() + (ctx.has_environment ? 1 : 0);
+  const size_t lights = s.max_wide_scatters == 1 ? 0 : ctx.lights.size();  // K = 1: environment only
+  const size_t sources = lights + (ctx.has_environment ? 1 : 0);
   if (sources == 0 || s.photons <= 0) return;
   const size_t per_source = std::max<size_t>(1, size_t(s.photons) / sources);
   const size_t total = size_t(passes) * sources * per_source;
@@ -166,7 +168,10 @@ ScatterGrid::ScatterGrid(const SceneContext& ctx, const std::vector<const PhaseS
     for (size_t j = begin; j < end; ++j) {
       Rng rng(s.seed ^ 0x6d756c7469706c65ull, j);
       const int pass = int(j / (sources * per_source));
-      const size_t source = (j / per_source) % sources;
+      size_t source = (j / per_source) % sources;
+      if (source >= lights) source = ctx.lights.size();  // the environment
+      // The environment's light is smooth in angle: the grid carries it from its entry (order 0).
+      const int first_order = source < ctx.lights.size() ? 1 : 0;
       const int c = pass;  // the channel whose coefficients drive this photon
       Photon ph = emit(ctx, source, centre, radius, double(per_source), rng);
       Rgb power = ph.power;
@@ -191,7 +196,7 @@ ScatterGrid::ScatterGrid(const SceneContext& ctx, const std::vector<const PhaseS
                 }
                 return true;
               });
-        if (order >= 1)
+        if (order >= first_order)
           deposit(x, w, hit ? (xc - x).length() : std::numeric_limits<double>::infinity(), power * weight);
         if (!hit) break;
         // A real collision at xc: albedo weight, roulette, medium, direction.

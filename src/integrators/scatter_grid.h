@@ -15,6 +15,9 @@
 // truncated at `bands` (2: l <= 1, 3: l <= 2; light after wide scatters is smooth in angle) and clamped
 // at zero.
 //
+// The environment (uniform radiance, smooth in angle) is carried by the grid from its entry: its
+// flights deposit from order 0, so `mfs` needs no environment sampling on the camera ray.
+//
 // Deterministic: photon i uses its own random stream; photons are split into a fixed number of
 // batches (each its own grid, summed in order), so the grid does not depend on the thread count.
 #pragma once

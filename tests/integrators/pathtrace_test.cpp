@@ -6,6 +6,7 @@
 #include <cstring>
 
 #include "integrators/pathtrace.h"
+#include "nimbus/error.h"
 #include "integrators/tracking.h"
 #include "nimbus/render.h"
 #include "render/lights.h"
@@ -141,6 +142,44 @@ TEST(PathTracer, TruncatedEventsApproachTheFurnaceFromBelow) {
     EXPECT_GT(s.c[0].mean, previous + 3 * s.c[0].stderr_mean()) << "max_events " << k;
     previous = s.c[0].mean;
   }
+}
+
+// The wide-scatter tally (mfs validation): with f = 0 every scatter is wide, so at most K wide scatters
+// is at most K events; with no limit reached it is the full radiance; the orders add up monotonically.
+TEST(PathTracer, WideScatterLimitPartitionsTheRadiance) {
+  const Scene scene = scene_from_json("{" + test::camera_json() + R"(,
+    "media": [{"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1}, "sigma_s": 3.0, "sigma_a": 0.1,
+               "phase": {"type": "hg", "g": 0.8}}],
+    "lights": [{"type": "directional", "direction": [1, 0.3, -0.2], "irradiance": 1.0},
+               {"type": "environment", "radiance": 0.3}]})");
+  const SceneContext ctx(scene);
+  const Vec3 o(0, -4, 0), d = normalize(Vec3(0.1, 1, 0.05));
+  const int n = 40000;
+  for (int K : {1, 2}) {
+    PathTraceSettings wide;
+    wide.max_wide_scatters = K;
+    wide.peak_fraction = 0.0;
+    const auto a = estimate(PathTracer(ctx, 0, wide), o, d, n), b = estimate(PathTracer(ctx, K), o, d, n, 2);
+    const double tol = 5.0 * std::hypot(a.c[0].stderr_mean(), b.c[0].stderr_mean());
+    EXPECT_NEAR(a.c[0].mean, b.c[0].mean, tol) << K;
+  }
+  PathTraceSettings all;
+  all.max_wide_scatters = 1 << 20;
+  const auto full = estimate(PathTracer(ctx, 0), o, d, n, 3), limited = estimate(PathTracer(ctx, 0, all), o, d, n, 4);
+  EXPECT_NEAR(full.c[0].mean, limited.c[0].mean, 5.0 * std::hypot(full.c[0].stderr_mean(), limited.c[0].stderr_mean()));
+  double previous = 0.0;
+  for (int K : {0, 1, 2, 4}) {
+    PathTraceSettings w;
+    w.max_wide_scatters = K;  // auto split (f = g^2)
+    const auto s = estimate(PathTracer(ctx, 0, w), o, d, n, 5);
+    EXPECT_GT(s.c[0].mean, previous) << K;
+    EXPECT_LT(s.c[0].mean, full.c[0].mean + 5.0 * full.c[0].stderr_mean()) << K;
+    previous = s.c[0].mean;
+  }
+  EXPECT_THROW(validate_integrator_options("pathtrace", nlohmann::json::parse(R"({"max_wide_scatters": -1})"), "t"),
+               Error);
+  EXPECT_NO_THROW(validate_integrator_options(
+      "pathtrace", nlohmann::json::parse(R"({"max_wide_scatters": 2, "peak_fraction": "auto"})"), "t"));
 }
 
 // Chord of the unit sphere at the origin from p along w (p inside).
