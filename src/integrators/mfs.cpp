@@ -30,11 +30,11 @@ MfsSettings parse_mfs_settings(const nlohmann::json& options, const std::string&
   }
   if (o.has("large_angle_scatters") && o.raw("large_angle_scatters").is_string()) {
     if (o.string("large_angle_scatters") != "all")
-      o.fail("large_angle_scatters", "must be \"all\" or an integer in [1, 1024]");
+      o.fail("large_angle_scatters", "must be \"all\" or an integer in [0, 1024]");
   } else {
-    s.large_angle_scatters = int(o.integer("large_angle_scatters", 1, 1024, 0));
+    s.large_angle_scatters = int(o.integer("large_angle_scatters", 0, 1024, -1));
   }
-  s.grid.max_wide_scatters = s.large_angle_scatters;
+  s.grid.max_wide_scatters = std::max(0, s.large_angle_scatters);
   s.grid.photons = int(o.integer("photons", 1, 1 << 26, s.grid.photons));
   s.grid.resolution = int(o.integer("scatter_grid_resolution", 4, 96, s.grid.resolution));
   s.grid.bands = int(o.integer("scatter_grid_bands", 2, 3, s.grid.bands));
@@ -67,7 +67,7 @@ MfsIntegrator::MfsIntegrator(const SceneContext& context, MfsSettings settings)
     if (s_.forward_light_path)
       reduced_maps_.emplace_back(ctx_.media, ctx_.majorants, l, s_.shadow_map_resolution, 0.05, f_);
   }
-  if (s_.large_angle_scatters != 1 || ctx_.has_environment) {
+  if (s_.large_angle_scatters != 0 && (s_.large_angle_scatters != 1 || ctx_.has_environment)) {
     std::vector<const PhaseSplit*> splits;
     for (const auto& sp : splits_) splits.push_back(sp.get());
     grid_ = std::make_unique<ScatterGrid>(ctx_, splits, f_, s_.grid);
@@ -102,12 +102,12 @@ Rgb MfsIntegrator::radiance(const Vec3& o, const Vec3& d, Rng& rng) const {
             const Rgb T_here = s_.light_side ? T_full * exp(-mp.sigma_t() * (jitter * dt))
                                              : T_red * exp(-sigma_red * (jitter * dt));
             const Rgb tp = tau_p + sigma_peak * (jitter * dt);
-            Rgb in_scatter(0.0);
+            Rgb in_scatter(0.0), peak_scatter(0.0);  // towards the camera through T_here / T_full
             for (int i = 0; i < mp.count; ++i) {
               if (max_component(mp.sigma_s_i[i]) <= 0.0) continue;
               const PhaseSplit& split = *splits_[i];
               const double f = f_[i];
-              Rgb Li(0.0);
+              Rgb Li(0.0), Li_peak(0.0);
               // Directional and point lights: wide term and peak term.
               for (size_t l = 0; l < ctx_.lights.size(); ++l) {
                 LightSample ls;
@@ -127,9 +127,21 @@ Rgb MfsIntegrator::radiance(const Vec3& o, const Vec3& d, Rng& rng) const {
                   }
                   continue;
                 }
-                for (int c = 0; c < 3; ++c)
-                  Li[c] += ls.weight[c] * ((1.0 - f) * split.wide_eff(tp[c], mu) * T_wide[c] +
-                                           f * split.peak_eff(tp[c], mu) * T_light[c]);
+                for (int c = 0; c < 3; ++c) {
+                  if (s_.large_angle_scatters != 0)
+                    Li[c] += ls.weight[c] * (1.0 - f) * split.wide_eff(tp[c], mu) * T_wide[c];
+                  if (s_.forward_light_path) {
+                    // Paths without a wide scatter, counted at their last peak scatter (here): the light's
+                    // forward-scattered beam (total T_wide, spread by the light-side peak depth
+                    // ln(T_wide / T_light)), then straight to the camera (plain transmittance).
+                    const double tps = T_light[c] > 1e-30 ? std::max(0.0, std::log(T_wide[c] / T_light[c]))
+                                                          : PhaseSplit::kTauMax;
+                    Li_peak[c] += ls.weight[c] * f * split.peak_eff(tps, mu) * T_wide[c];
+                  } else {
+                    // beer_lambert: first (peak) scatter here, unscattered light, the propagator to the camera.
+                    Li[c] += ls.weight[c] * f * split.peak_eff(tp[c], mu) * T_light[c];
+                  }
+                }
               }
               // Light that already took wide scatters (and the environment's light): its last wide scatter
               // is here.
@@ -160,8 +172,9 @@ Rgb MfsIntegrator::radiance(const Vec3& o, const Vec3& d, Rng& rng) const {
                 }
               }
               in_scatter += mp.sigma_s_i[i] * Li;
+              peak_scatter += mp.sigma_s_i[i] * Li_peak;
             }
-            L += T_here * in_scatter * dt;
+            L += (T_here * in_scatter + T_full * exp(-mp.sigma_t() * (jitter * dt)) * peak_scatter) * dt;
           }
           T_full *= exp(-mp.sigma_t() * dt);
           T_red *= exp(-sigma_red * dt);

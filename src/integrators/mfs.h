@@ -41,7 +41,7 @@ struct MfsSettings {
   bool gaussian = false;           // propagator: "gsa" (false) or "gaussian" (Gaussian stand-in for the peak)
   double peak_fraction = -1.0;     // f in [0, 0.99]; < 0: "auto" (g^2 per medium)
   bool light_side = false;       // forward_side "light": peak scatters on the light's side, exact camera leg
-  int large_angle_scatters = 0;    // K: at most K wide scatters per path; 0 = "all"
+  int large_angle_scatters = -1;   // K: at most K wide scatters per path (0: none, the peak only); -1 = "all"
   int shadow_map_resolution = 64;
   ScatterGridSettings grid;  // the higher orders (K != 1): photons, resolution; seed from the scene
 };
