@@ -37,7 +37,7 @@ MfsSettings parse_mfs_settings(const nlohmann::json& options, const std::string&
   s.grid.max_wide_scatters = std::max(0, s.large_angle_scatters);
   s.grid.photons = int(o.integer("photons", 1, 1 << 26, s.grid.photons));
   s.grid.resolution = int(o.integer("scatter_grid_resolution", 4, 96, s.grid.resolution));
-  s.grid.bands = int(o.integer("scatter_grid_bands", 2, 3, s.grid.bands));
+  s.grid.bands = int(o.integer("scatter_grid_bands", 1, kShMaxBands, s.grid.bands));
   const std::string transport = o.string("photon_transport", "exact");
   if (transport != "similarity" && transport != "exact")
     o.fail("photon_transport", "must be \"similarity\" or \"exact\"");
@@ -138,7 +138,8 @@ Rgb MfsIntegrator::radiance(const Vec3& o, const Vec3& d, Rng& rng) const {
                                                           : PhaseSplit::kTauMax;
                     Li_peak[c] += ls.weight[c] * f * split.peak_eff(tps, mu) * T_wide[c];
                   } else {
-                    // beer_lambert: first (peak) scatter here, unscattered light, the propagator to the camera.
+                    // beer_lambert: first (peak) scatter here, unscattered light, the propagator to the
+                    // camera.
                     Li[c] += ls.weight[c] * f * split.peak_eff(tp[c], mu) * T_light[c];
                   }
                 }
@@ -148,28 +149,21 @@ Rgb MfsIntegrator::radiance(const Vec3& o, const Vec3& d, Rng& rng) const {
               if (grid_) {
                 const std::vector<double>& chi_w = split.wide_moments();
                 const std::vector<double>& chi_p = split.peak_moments();
-                // The wide part's Legendre moments after the camera-side peak blur.
-                auto chi = [&](size_t l, double tau) {
-                  if (chi_w.size() <= l) return 0.0;
-                  return chi_w[l] * std::exp(-tau * (chi_p.size() > l ? 1.0 - chi_p[l] : 0.0));
+                auto moment = [](const std::vector<double>& m, int l, double fallback) {
+                  return int(m.size()) > l ? m[l] : fallback;
                 };
-                Rgb chi1, chi2;
-                for (int c = 0; c < 3; ++c) {
-                  chi1[c] = chi(1, tp[c]);
-                  chi2[c] = chi(2, tp[c]);
-                }
-                if (s_.light_side) {
-                  // Every scatter at p (whole phase function), no camera-side blur: the camera leg is exact.
+                std::array<Rgb, kShMaxBands> chi;
+                for (int l = 0; l < grid_->bands(); ++l) {
                   for (int c = 0; c < 3; ++c) {
-                    chi1[c] = f * (chi_p.size() > 1 ? chi_p[1] : 1.0) +
-                              (1.0 - f) * (chi_w.size() > 1 ? chi_w[1] : 0.0);
-                    chi2[c] = f * (chi_p.size() > 2 ? chi_p[2] : 1.0) +
-                              (1.0 - f) * (chi_w.size() > 2 ? chi_w[2] : 0.0);
+                    chi[l][c] =
+                        s_.light_side
+                            // Every scatter at p (whole phase function); the camera leg is exact.
+                            ? f * moment(chi_p, l, 1.0) + (1.0 - f) * moment(chi_w, l, 0.0)
+                            // The wide part's moments after the camera-side peak blur.
+                            : moment(chi_w, l, 0.0) * std::exp(-tp[c] * (1.0 - moment(chi_p, l, 1.0)));
                   }
-                  Li += grid_->scattered(p, -d, chi1, chi2);
-                } else {
-                  Li += (1.0 - f) * grid_->scattered(p, -d, chi1, chi2);
                 }
+                Li += (s_.light_side ? 1.0 : 1.0 - f) * grid_->scattered(p, -d, chi);
               }
               in_scatter += mp.sigma_s_i[i] * Li;
               peak_scatter += mp.sigma_s_i[i] * Li_peak;

@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "core/sh.h"
 #include "integrators/shadow_map.h"
 #include "integrators/tracking.h"
 
@@ -13,23 +14,6 @@ namespace {
 constexpr int kBatches = 8;             // fixed: the grid must not depend on the thread count
 constexpr int kMaxWideScatters = 1024;  // photons are ended after this many wide scatters ...
 constexpr int kMaxEvents = 1 << 20;     // ... or real collisions
-constexpr int kCoeffs = 9;              // real spherical harmonics, bands l = 0, 1, 2
-constexpr int kFloatsPerNode = 3 * kCoeffs;
-constexpr int kBand[kCoeffs] = {0, 1, 1, 1, 2, 2, 2, 2, 2};
-
-// The real spherical harmonics Y_lm(w), l <= 2, of a unit vector.
-void sh9(const Vec3& w, double* y) {
-  y[0] = 0.28209479177387814;
-  y[1] = 0.4886025119029199 * w.y;
-  y[2] = 0.4886025119029199 * w.z;
-  y[3] = 0.4886025119029199 * w.x;
-  y[4] = 1.0925484305920792 * w.x * w.y;
-  y[5] = 1.0925484305920792 * w.y * w.z;
-  y[6] = 0.31539156525252005 * (3.0 * w.z * w.z - 1.0);
-  y[7] = 1.0925484305920792 * w.x * w.z;
-  y[8] = 0.5462742152960396 * (w.x * w.x - w.y * w.y);
-}
-
 struct Photon {
   Vec3 x, w;
   Rgb power;
@@ -77,12 +61,14 @@ Photon emit(const SceneContext& ctx, size_t source, const Vec3& c, double r, dou
 }  // namespace
 
 ScatterGrid::ScatterGrid(const SceneContext& ctx, const std::vector<const PhaseSplit*>& splits,
-                         const std::vector<double>& peak_fraction, const ScatterGridSettings& s) {
+                         const std::vector<double>& peak_fraction, const ScatterGridSettings& s)
+    : bands_(std::clamp(s.bands, 1, kShMaxBands)), coeffs_(bands_ * bands_) {
+  const int kCoeffs = coeffs_, kFloatsPerNode = 3 * coeffs_;
   const Bounds media_bounds = ctx.media.bounds();
   if (media_bounds.empty()) {
     bounds_.lo = Vec3(0.0);
     bounds_.hi = Vec3(1.0);
-    values_.assign(size_t(8) * kFloatsPerNode, 0.0f);
+    values_.assign(size_t(8) * 3 * coeffs_, 0.0f);
     return;
   }
   const Vec3 extent = media_bounds.hi - media_bounds.lo;
@@ -96,9 +82,8 @@ ScatterGrid::ScatterGrid(const SceneContext& ctx, const std::vector<const PhaseS
     bounds_.lo[a] = media_bounds.lo[a] - spacing_[a];
     bounds_.hi[a] = bounds_.lo[a] + spacing_[a] * (nodes_[a] - 1);
   }
-  bands_ = s.bands;
   const size_t node_count = size_t(nodes_[0]) * nodes_[1] * nodes_[2];
-  values_.assign(node_count * kFloatsPerNode, 0.0f);
+  values_.assign(node_count * 3 * coeffs_, 0.0f);
   // With K = 1 only the environment's unscattered-by-wide light is needed (see the header).
   if (s.max_wide_scatters == 1 && !ctx.has_environment) return;
 
@@ -158,8 +143,8 @@ ScatterGrid::ScatterGrid(const SceneContext& ctx, const std::vector<const PhaseS
       if (!(len > 0.0)) return;
       const int n = std::max(1, int(std::ceil(len / (0.5 * h_min))));
       const Rgb v = power * (len / n);
-      double y[kCoeffs];
-      sh9(w, y);
+      double y[kShMaxBands * kShMaxBands];
+      sh_eval(w, bands_, y);
       for (int k = 0; k < n; ++k) splat(x + w * (t0 + (k + 0.5) * len / n), y, v);
     };
 
@@ -257,9 +242,10 @@ ScatterGrid::ScatterGrid(const SceneContext& ctx, const std::vector<const PhaseS
   });
 }
 
-void ScatterGrid::lookup(const Vec3& p, std::array<double, 27>* coeffs) const {
-  coeffs->fill(0.0);
-  if (!bounds_.contains(p)) return;
+Rgb ScatterGrid::scattered(const Vec3& p, const Vec3& w_out, const std::array<Rgb, kShMaxBands>& chi) const {
+  if (!bounds_.contains(p)) return Rgb(0.0);
+  const int floats = 3 * coeffs_;
+  double L[3 * kShMaxBands * kShMaxBands] = {};
   int i[3];
   double fr[3];
   for (int a = 0; a < 3; ++a) {
@@ -271,21 +257,16 @@ void ScatterGrid::lookup(const Vec3& p, std::array<double, 27>* coeffs) const {
     const int dx = k & 1, dy = (k >> 1) & 1, dz = (k >> 2) & 1;
     const double wt = (dx ? fr[0] : 1 - fr[0]) * (dy ? fr[1] : 1 - fr[1]) * (dz ? fr[2] : 1 - fr[2]);
     const float* node =
-        &values_[((size_t(i[2] + dz) * nodes_[1] + i[1] + dy) * nodes_[0] + i[0] + dx) * kFloatsPerNode];
-    for (int h = 0; h < kFloatsPerNode; ++h) (*coeffs)[h] += wt * node[h];
+        &values_[((size_t(i[2] + dz) * nodes_[1] + i[1] + dy) * nodes_[0] + i[0] + dx) * floats];
+    for (int h = 0; h < floats; ++h) L[h] += wt * node[h];
   }
-}
-
-Rgb ScatterGrid::scattered(const Vec3& p, const Vec3& w_out, const Rgb& chi1, const Rgb& chi2) const {
-  std::array<double, 27> L;
-  lookup(p, &L);
-  double y[kCoeffs];
-  sh9(w_out, y);
+  double y[kShMaxBands * kShMaxBands];
+  sh_eval(w_out, bands_, y);
   Rgb r;
   for (int c = 0; c < 3; ++c) {
-    const double chi[3] = {1.0, chi1[c], bands_ > 2 ? chi2[c] : 0.0};
     double v = 0.0;
-    for (int h = 0; h < kCoeffs; ++h) v += chi[kBand[h]] * L[kCoeffs * c + h] * y[h];
+    for (int l = 0; l < bands_; ++l)
+      for (int h = l * l; h < (l + 1) * (l + 1); ++h) v += chi[l][c] * L[coeffs_ * c + h] * y[h];
     r[c] = std::max(0.0, v);
   }
   return r;

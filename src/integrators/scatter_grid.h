@@ -7,12 +7,13 @@
 // scatter counted as wide with probability (1 - f) P_wide / P) or through the similarity medium
 // ("similarity": peak scatters leave light on its way; extinction sigma_a + (1 - f) sigma_s, scattering
 // (1 - f) sigma_s with P_wide drawn by rejection from P). Every flight after the first wide scatter,
-// and before the K-th, deposits its track length (the track-length estimator of fluence, unbiased) into a coarse node grid, as the real spherical-harmonic moments of bands l <= 2:
+// and before the K-th, deposits its track length (the track-length estimator of fluence, unbiased) into a
+// coarse node grid, as the real spherical-harmonic moments of bands l <= 2:
 //     L_lm(x) = int L(x, w) Y_lm(w) dw      (w: direction of travel; L_00 = phi / sqrt(4 pi)).
 // `mfs` adds one more wide scatter at each march point y towards the camera (travel direction w_o);
 // by Funk-Hecke, with chi_l the Legendre moments of P_wide (chi_0 = 1, chi_1 = g_wide),
 //     int P_wide(w . w_o) L(y, w) dw = sum_lm chi_l L_lm(y) Y_lm(w_o),
-// truncated at `bands` (2: l <= 1, 3: l <= 2; light after wide scatters is smooth in angle) and clamped
+// truncated at `bands` (default 3: l <= 2; light after wide scatters is smooth in angle) and clamped
 // at zero.
 //
 // The environment (uniform radiance, smooth in angle) is carried by the grid from its entry: its
@@ -26,18 +27,19 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/sh.h"
 #include "integrators/integrator.h"
 #include "transport/phase_split.h"
 
 namespace nimbus {
 
 struct ScatterGridSettings {
-  int photons = 1 << 18;         // per channel pass, shared among the lights
-  int resolution = 32;           // nodes along the longest axis of the media's bounds
-  int max_wide_scatters = 0;     // K: flights after wide scatter 1 .. K-1 are kept; 0 = all orders
+  int photons = 1 << 18;        // per channel pass, shared among the lights
+  int resolution = 32;          // nodes along the longest axis of the media's bounds
+  int max_wide_scatters = 0;    // K: flights after wide scatter 1 .. K-1 are kept; 0 = all orders
   bool exact_transport = true;  // photons in the true medium (every collision; scatters classified peak
                                 // or wide by their share) or (false) in the similarity medium
-  int bands = 3;                 // spherical-harmonic bands used at lookup: 2 (l <= 1) or 3 (l <= 2)
+  int bands = 3;                // spherical-harmonic bands used at lookup: 2 (l <= 1) or 3 (l <= 2)
   uint64_t seed = 1;
 };
 
@@ -47,11 +49,11 @@ class ScatterGrid {
   ScatterGrid(const SceneContext& ctx, const std::vector<const PhaseSplit*>& splits,
               const std::vector<double>& peak_fraction, const ScatterGridSettings& settings);
 
-  // The moments at p, trilinear between nodes (zero outside the grid): [9 c + (l^2 + l + m)].
-  void lookup(const Vec3& p, std::array<double, 27>* coeffs) const;
-  // sum_lm chi_l L_lm(p) Y_lm(w_out) per channel (chi_0 = 1), clamped at zero: the radiance a unit of
-  // wide scattering with Legendre moments chi_1, chi_2 (per channel) sends along w_out.
-  Rgb scattered(const Vec3& p, const Vec3& w_out, const Rgb& chi1, const Rgb& chi2) const;
+  // sum_lm chi_l L_lm(p) Y_lm(w_out) per channel, l < bands (moments trilinear between nodes, zero
+  // outside the grid), clamped at zero: the radiance a unit of scattering with Legendre moments chi_l
+  // (per channel; chi_0 = 1 for a normalised phase function) sends along w_out.
+  Rgb scattered(const Vec3& p, const Vec3& w_out, const std::array<Rgb, kShMaxBands>& chi) const;
+  int bands() const { return bands_; }
 
   size_t memory_bytes() const { return values_.size() * sizeof(float); }
   const std::array<int, 3>& nodes() const { return nodes_; }
@@ -61,8 +63,8 @@ class ScatterGrid {
   Bounds bounds_;  // of the node grid (the media's bounds padded by one spacing)
   std::array<int, 3> nodes_{2, 2, 2};
   Vec3 spacing_{1.0};
-  int bands_ = 3;
-  std::vector<float> values_;  // per node: channel c at [9 c + h]: L_lm, h = l^2 + l + m
+  int bands_ = 3, coeffs_ = 9;
+  std::vector<float> values_;  // per node: channel c at [coeffs c + h]: L_lm, h = l^2 + l + m
   double photons_traced_ = 0.0;
 };
 

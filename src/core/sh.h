@@ -1,0 +1,52 @@
+// Real spherical harmonics Y_lm of a unit vector, bands l < kShMaxBands, orthonormal on the sphere
+// (int Y_lm Y_l'm' dw = delta), index l^2 + l + m. Built from Re/Im (x + i y)^m and the polynomial
+// part of the associated Legendre functions, so there is no division by sin(theta) at the poles.
+// Only sums over m are used (sum_m Y_lm(a) Y_lm(b) = (2l + 1) / (4 pi) P_l(a . b)), which do not
+// depend on the sign convention.
+#pragma once
+
+#include <cmath>
+
+#include "core/math.h"
+
+namespace nimbus {
+
+inline constexpr int kShMaxBands = 6;
+
+// y[0 .. bands^2) for 1 <= bands <= kShMaxBands.
+inline void sh_eval(const Vec3& w, int bands, double* y) {
+  // Normalisation K_lm = sqrt((2l + 1) / (4 pi) (l - m)! / (l + m)!), times sqrt(2) for m != 0.
+  double A[kShMaxBands], B[kShMaxBands];  // Re, Im of (x + i y)^m
+  A[0] = 1.0;
+  B[0] = 0.0;
+  for (int m = 1; m < bands; ++m) {
+    A[m] = A[m - 1] * w.x - B[m - 1] * w.y;
+    B[m] = A[m - 1] * w.y + B[m - 1] * w.x;
+  }
+  for (int m = 0; m < bands; ++m) {
+    // Q_l^m(z) = P_l^m(z) / (1 - z^2)^(m/2) for l = m, m+1, ...
+    double q_prev = 0.0, q = 1.0;
+    for (int k = 1; k <= m; ++k) q *= -(2.0 * k - 1.0);  // (-1)^m (2m - 1)!!
+    for (int l = m; l < bands; ++l) {
+      if (l == m + 1) {
+        q_prev = q;
+        q = w.z * (2.0 * m + 1.0) * q;
+      } else if (l > m + 1) {
+        const double next = ((2.0 * l - 1.0) * w.z * q - (l + m - 1.0) * q_prev) / (l - m);
+        q_prev = q;
+        q = next;
+      }
+      double ratio = 1.0;  // (l - m)! / (l + m)!
+      for (int k = l - m + 1; k <= l + m; ++k) ratio /= k;
+      const double K = std::sqrt((2.0 * l + 1.0) / (4.0 * kPi) * ratio);
+      if (m == 0) {
+        y[l * l + l] = K * q;
+      } else {
+        y[l * l + l + m] = std::sqrt(2.0) * K * q * A[m];
+        y[l * l + l - m] = std::sqrt(2.0) * K * q * B[m];
+      }
+    }
+  }
+}
+
+}  // namespace nimbus
