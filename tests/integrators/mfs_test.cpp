@@ -288,6 +288,26 @@ TEST(Mfs, PeakOnlyPathsMatchThePathTracer) {
   EXPECT_NEAR(m[0], ref[0], 0.05 * ref[0]);
 }
 
+// A point light (inside the media's bounding sphere, so photons leave it in every direction) and
+// chromatic coefficients (one photon pass per channel): isotropic scattering, all orders, against the
+// path tracer.
+TEST(Mfs, PointLightAndChromaticMediumMatchPathTracer) {
+  Scene scene = test::scene_from_json("{" + test::camera_json(20, 20, 40.0) + R"(,
+    "media": [{"shape": {"type": "box", "min": [-1, -1, -1], "max": [1, 1, 1]}, "sigma_s": [0.6, 1.0, 1.6],
+               "sigma_a": 0.05}],
+    "lights": [{"type": "point", "position": [0.9, -0.4, 1.2], "intensity": 2.0}]})");
+  scene.integrator.type = "pathtrace";
+  scene.integrator.spp = 512;
+  const Rgb ref = image_mean(render(scene, RenderOptions{}).image);
+  scene.integrator.type = "mfs";
+  scene.integrator.spp = 4;
+  scene.integrator.options = {{"tau_step", 0.05}, {"photons", 1 << 18}, {"scatter_grid_resolution", 24}};
+  const Rgb m = image_mean(render(scene, RenderOptions{}).image);
+  std::printf("point light, chromatic: mfs %.5f %.5f %.5f pathtrace %.5f %.5f %.5f\n", m[0], m[1], m[2], ref[0],
+              ref[1], ref[2]);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(m[c], ref[c], 0.03 * ref[c]) << c;
+}
+
 TEST(Mfs, MoreWideScattersAddLight) {
   Scene scene = test::scene_from_json("{" + test::camera_json(12, 12, 20.0) + R"(,
     "media": [{"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1}, "sigma_s": 6.0, "sigma_a": 0.01,
