@@ -45,6 +45,7 @@ MfsSettings parse_mfs_settings(const nlohmann::json& options, const std::string&
   const std::string side = o.string("forward_side", "camera");
   if (side != "camera" && side != "light") o.fail("forward_side", "must be \"camera\" or \"light\"");
   s.light_side = side == "light";
+  s.path_lengthening = o.boolean("path_lengthening", s.path_lengthening);
   if (s.light_side) {
     s.forward_light_path = true;
     s.grid.exact_transport = true;
@@ -61,6 +62,7 @@ MfsIntegrator::MfsIntegrator(const SceneContext& context, MfsSettings settings)
     const double f = s_.peak_fraction < 0.0 ? std::min(0.99, auto_peak_fraction(phase)) : s_.peak_fraction;
     splits_.push_back(std::make_unique<PhaseSplit>(phase, f, s_.gaussian));
     f_.push_back(splits_.back()->f());
+    theta2_.push_back(splits_.back()->theta2());
   }
   for (const Light& l : ctx_.lights) {
     full_maps_.emplace_back(ctx_.media, ctx_.majorants, l, s_.shadow_map_resolution, 0.05);
@@ -85,22 +87,43 @@ Rgb MfsIntegrator::sample(double px, double py, Rng& rng) const {
   return radiance(ctx_.camera.origin(), ctx_.camera.direction(px, py), rng);
 }
 
+namespace {
+// 1 / cosh(sqrt(theta tau)): the extra loss on paths lengthened by peak deflections (the corrected MFS
+// kernel's total, W / cosh(z / L) with (z / L)^2 = a theta2 b z^2; notes/mfs-math.md), for an
+// accumulated angular diffusion theta = int theta2 dtau_peak and loss depth tau (wide scatters and
+// absorption).
+double lengthening(double theta, double tau) {
+  const double x = std::sqrt(std::max(0.0, theta * tau));
+  const double e = std::exp(-x);
+  return 2.0 * e / (1.0 + e * e);
+}
+}  // namespace
+
 Rgb MfsIntegrator::radiance(const Vec3& o, const Vec3& d, Rng& rng) const {
   // T_full: plain transmittance (background); T_red: reduced extinction (wide scatters and absorption);
   // tau_p: peak optical depth, all from the camera to the current point.
-  Rgb L(0.0), T_full(1.0), T_red(1.0), tau_p(0.0);
+  // theta_p: the accumulated angular diffusion int theta2 dtau_p (per-component mean square angle of the
+  // peaks), tau_red = -ln T_red: together the path-lengthening factor 1 / cosh(sqrt(theta_p tau_red)).
+  Rgb L(0.0), T_full(1.0), T_red(1.0), tau_p(0.0), theta_p(0.0), tau_red(0.0);
   const double jitter = rng.uniform();
   MediumPoint mp;
   march(ctx_.majorants, o, d, std::numeric_limits<double>::infinity(), s_.tau_step, jitter,
         [&](const Vec3& p, double, double dt) {
           ctx_.media.eval(p, &mp);
-          Rgb sigma_peak(0.0);
-          for (int i = 0; i < mp.count; ++i) sigma_peak += mp.sigma_s_i[i] * f_[i];
+          Rgb sigma_peak(0.0), sigma_theta(0.0);
+          for (int i = 0; i < mp.count; ++i) {
+            sigma_peak += mp.sigma_s_i[i] * f_[i];
+            sigma_theta += mp.sigma_s_i[i] * (f_[i] * theta2_[i]);
+          }
           const Rgb sigma_red = mp.sigma_t() - sigma_peak;
           if (max_component(mp.sigma_s) > 0.0) {
             // Camera-side depths at the sample point.
-            const Rgb T_here = s_.light_side ? T_full * exp(-mp.sigma_t() * (jitter * dt))
-                                             : T_red * exp(-sigma_red * (jitter * dt));
+            Rgb T_here = s_.light_side ? T_full * exp(-mp.sigma_t() * (jitter * dt))
+                                       : T_red * exp(-sigma_red * (jitter * dt));
+            if (!s_.light_side && s_.path_lengthening)
+              for (int c = 0; c < 3; ++c)
+                T_here[c] *= lengthening(theta_p[c] + sigma_theta[c] * jitter * dt,
+                                         tau_red[c] + sigma_red[c] * jitter * dt);
             const Rgb tp = tau_p + sigma_peak * (jitter * dt);
             Rgb in_scatter(0.0), peak_scatter(0.0);  // towards the camera through T_here / T_full
             for (int i = 0; i < mp.count; ++i) {
@@ -115,15 +138,21 @@ Rgb MfsIntegrator::radiance(const Vec3& o, const Vec3& d, Rng& rng) const {
                 if (!sample_light(ctx_.lights[l], p, u1, u2, &ls)) continue;
                 const double mu = dot(d, ls.wi);
                 const Rgb T_light = full_maps_[l].lookup(p);
-                const Rgb T_wide = s_.forward_light_path ? reduced_maps_[l].lookup(p) : T_light;
+                Rgb T_wide = s_.forward_light_path ? reduced_maps_[l].lookup(p) : T_light;
+                // Light-side peak depth ln(T_wide / T_light) and its path lengthening.
+                Rgb tps(0.0);
+                for (int c = 0; c < 3; ++c) {
+                  tps[c] = T_light[c] > 1e-30 ? std::max(0.0, std::log(T_wide[c] / T_light[c]))
+                                              : PhaseSplit::kTauMax;
+                  if (s_.forward_light_path && s_.path_lengthening && T_wide[c] > 0.0)
+                    T_wide[c] *= lengthening(theta2_[i] * tps[c], -std::log(T_wide[c]));
+                }
                 if (s_.light_side) {
                   // The light's peak-only (zero wide scatter) beam at p: total T_wide, spread by the
                   // light-side peak depth ln(T_wide / T_light); scattered by the whole phase function.
                   for (int c = 0; c < 3; ++c) {
-                    const double tps = T_light[c] > 1e-30 ? std::max(0.0, std::log(T_wide[c] / T_light[c]))
-                                                          : PhaseSplit::kTauMax;
                     Li[c] += ls.weight[c] * T_wide[c] *
-                             ((1.0 - f) * split.wide_eff(tps, mu) + f * split.peak_eff(tps, mu));
+                             ((1.0 - f) * split.wide_eff(tps[c], mu) + f * split.peak_eff(tps[c], mu));
                   }
                   continue;
                 }
@@ -134,9 +163,7 @@ Rgb MfsIntegrator::radiance(const Vec3& o, const Vec3& d, Rng& rng) const {
                     // Paths without a wide scatter, counted at their last peak scatter (here): the light's
                     // forward-scattered beam (total T_wide, spread by the light-side peak depth
                     // ln(T_wide / T_light)), then straight to the camera (plain transmittance).
-                    const double tps = T_light[c] > 1e-30 ? std::max(0.0, std::log(T_wide[c] / T_light[c]))
-                                                          : PhaseSplit::kTauMax;
-                    Li_peak[c] += ls.weight[c] * f * split.peak_eff(tps, mu) * T_wide[c];
+                    Li_peak[c] += ls.weight[c] * f * split.peak_eff(tps[c], mu) * T_wide[c];
                   } else {
                     // beer_lambert: first (peak) scatter here, unscattered light, the propagator to the
                     // camera.
@@ -173,6 +200,8 @@ Rgb MfsIntegrator::radiance(const Vec3& o, const Vec3& d, Rng& rng) const {
           T_full *= exp(-mp.sigma_t() * dt);
           T_red *= exp(-sigma_red * dt);
           tau_p += sigma_peak * dt;
+          theta_p += sigma_theta * dt;
+          tau_red += sigma_red * dt;
           return max_component(s_.light_side ? T_full : T_red) > 1e-6;
         });
   // The environment behind the medium; its scattered light is in the grid. Camera side: its peak-scattered

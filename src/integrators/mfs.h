@@ -40,8 +40,9 @@ struct MfsSettings {
   bool forward_light_path = true;  // light_path: "forward" (true) or "beer_lambert"
   bool gaussian = false;           // propagator: "gsa" (false) or "gaussian" (Gaussian stand-in for the peak)
   double peak_fraction = -1.0;     // f in [0, 0.99]; < 0: "auto" (g^2 per medium)
-  bool light_side = false;       // forward_side "light": peak scatters on the light's side, exact camera leg
-  int large_angle_scatters = -1;   // K: at most K wide scatters per path (0: none, the peak only); -1 = "all"
+  bool path_lengthening = false;   // the 1 / cosh loss on paths lengthened by peak deflections
+  bool light_side = false;        // forward_side "light": peak scatters on the light's side, exact camera leg
+  int large_angle_scatters = -1;  // K: at most K wide scatters per path (0: none, the peak only); -1 = "all"
   int shadow_map_resolution = 64;
   ScatterGridSettings grid;  // the higher orders (K != 1): photons, resolution; seed from the scene
 };
@@ -64,6 +65,7 @@ class MfsIntegrator final : public Integrator {
   MfsSettings s_;
   std::vector<std::unique_ptr<PhaseSplit>> splits_;          // per medium
   std::vector<double> f_;                                    // per medium peak fraction
+  std::vector<double> theta2_;                               // per medium peak's mean square angle
   std::vector<TransmittanceGrid> full_maps_, reduced_maps_;  // per light
   std::unique_ptr<ScatterGrid> grid_;                        // wide scatters 2 .. K (null for K = 1)
 };

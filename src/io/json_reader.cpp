@@ -98,6 +98,16 @@ std::string JsonObject::string(const std::string& key) {
   return v.get<std::string>();
 }
 
+bool JsonObject::boolean(const std::string& key, bool fallback) {
+  if (!has(key)) {
+    used_.insert(key);
+    return fallback;
+  }
+  const nlohmann::json& v = field(key);
+  if (!v.is_boolean()) fail(key, fmt::format("must be true or false, not {}", type_name(v)));
+  return v.get<bool>();
+}
+
 std::string JsonObject::string(const std::string& key, const std::string& fallback) {
   if (!has(key)) {
     used_.insert(key);

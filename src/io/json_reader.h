@@ -34,6 +34,7 @@ class JsonObject {
   int64_t integer(const std::string& key, int64_t lo, int64_t hi, int64_t fallback);
   std::string string(const std::string& key);
   std::string string(const std::string& key, const std::string& fallback);
+  bool boolean(const std::string& key, bool fallback);
   Vec3 vec3(const std::string& key);
   Vec3 vec3(const std::string& key, const Vec3& fallback);
   // A number (grey) or [r, g, b], each component >= lo.

@@ -33,7 +33,7 @@ class PhaseSplit {
   // assumption) instead of its own (the generalised propagator).
   PhaseSplit(const Phase& phase, double peak_fraction, bool gaussian = false);
 
-  double f() const { return f_; }             // achieved peak fraction
+  double f() const { return f_; }                // achieved peak fraction
   double cut_angle() const { return theta_c_; }  // theta_c [rad]
   // Normalised parts, per sr, at cos_theta between propagation directions.
   double wide(double cos_theta) const;
@@ -43,6 +43,10 @@ class PhaseSplit {
   double peak_eff(double tau_p, double cos_theta) const { return lookup(peak_table_, tau_p, cos_theta); }
 
   const std::vector<double>& peak_moments() const { return chi_peak_; }
+  // The peak's per-component mean square deflection, (1 - chi_2) / 3 (0 without a peak).
+  double theta2() const {
+    return f_ > 0.0 && chi_peak_.size() > 2 ? std::max(0.0, (1.0 - chi_peak_[2]) / 3.0) : 0.0;
+  }
   const std::vector<double>& wide_moments() const { return chi_wide_; }
 
   static constexpr double kTauMax = 64.0;

@@ -163,7 +163,9 @@ TEST(Mfs, OptionsAreValidatedStrictly) {
   EXPECT_THROW(parse(R"({"peak_fraction": 1.5})"), Error);
   EXPECT_NO_THROW(parse(R"({"large_angle_scatters": 3, "photons": 1000, "scatter_grid_resolution": 16})"));
   EXPECT_NO_THROW(parse(R"({"large_angle_scatters": "all"})"));
-  EXPECT_NO_THROW(parse(R"({"photon_transport": "similarity", "forward_side": "light", "scatter_grid_bands": 2})"));
+  EXPECT_NO_THROW(parse(R"({"photon_transport": "similarity", "forward_side": "light", "scatter_grid_bands": 2,
+                            "path_lengthening": true})"));
+  EXPECT_THROW(parse(R"({"path_lengthening": 1})"), Error);
   EXPECT_THROW(parse(R"({"photon_transport": "fast"})"), Error);
   EXPECT_THROW(parse(R"({"forward_side": "both"})"), Error);
   EXPECT_THROW(parse(R"({"scatter_grid_bands": 7})"), Error);
