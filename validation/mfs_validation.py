@@ -122,7 +122,11 @@ def main():
     ap.add_argument("--only")
     ap.add_argument("--orders", action="store_true", help="only the order-by-order comparison")
     ap.add_argument("--tables", action="store_true", help="only rewrite tables and plots from the results")
+    ap.add_argument("--size-study", action="store_true", help="only the 160x120 equal-error study")
     args = ap.parse_args()
+    if args.size_study:
+        os.makedirs(TMP, exist_ok=True)
+        return size_study()
     if args.orders:
         os.makedirs(TMP, exist_ok=True)
         return orders()
@@ -223,6 +227,41 @@ def orders():
         a, b = d.find("<!-- orders -->"), d.find("<!-- /orders -->")
         if a >= 0 and b > a:
             open(doc, "w").write(d[:a] + "<!-- orders -->\n" + text + "\n" + d[b:])
+
+
+def size_study():
+    """Equal-error speed-up on the Disney cloud at a production-like size (fixed costs amortised)."""
+    scene, base, _ = cloud(0.2)
+    scene = json.loads(json.dumps(scene))
+    scene["camera"]["width"], scene["camera"]["height"] = 160, 120
+    ref = os.path.join(REFS, "disney_cloud_160_pt1024.exr")
+    half = os.path.join(REFS, "disney_cloud_160_pt512_seed2.exr")
+    if not os.path.exists(ref):
+        render(scene, base, {"type": "pathtrace"}, 1024, ref)
+    if not os.path.exists(half):
+        render(scene, base, {"type": "pathtrace"}, 512, half, seed=2)
+    noise = compare(half, ref)[1] / math.sqrt(3.0)
+    rows = {"reference_noise_rel_rmse": noise, "pathtrace": [], "configs": {}}
+    for spp in (4, 16, 64):
+        out = os.path.join(TMP, f"size_pt{spp}.exr")
+        t = render(scene, base, {"type": "pathtrace"}, spp, out, seed=3)
+        m, e, _ = compare(out, ref)
+        rows["pathtrace"].append({"spp": spp, "time_s": t, "mean_error": m, "rel_rmse": e})
+    last, first = rows["pathtrace"][-1], rows["pathtrace"][0]
+    c2 = max(last["rel_rmse"] ** 2 - noise ** 2, 1e-12) * last["spp"]
+    k = max((last["time_s"] - first["time_s"]) / (last["spp"] - first["spp"]), 1e-9)
+    for label, block, spp in (("mfs 4 spp", {"type": "mfs"}, 4), ("mfs 1 spp", {"type": "mfs"}, 1),
+                              ("single 4 spp", {"type": "single", "transmittance": "shadow_map"}, 4),
+                              ("octave 4 spp", {"type": "octave"}, 4)):
+        out = os.path.join(TMP, f"size_{label.replace(' ', '_')}.exr")
+        t = render(scene, base, block, spp, out)
+        m, e, _ = compare(out, ref)
+        need = c2 / max(e ** 2 - noise ** 2, 1e-12)
+        rows["configs"][label] = {"time_s": t, "mean_error": m, "rel_rmse": e, "pathtrace_spp": need,
+                                  "pathtrace_time_s": k * need, "speedup": k * need / t}
+        print(f"160x120 {label:14s} mean {m:+.3f} rrmse {e:.3f} time {t:.1f}s  pathtrace needs {need:.0f} spp "
+              f"= {k * need:.0f}s: {k * need / t:.1f}x", flush=True)
+    json.dump(rows, open(os.path.join(DOCS, "render_size_study.json"), "w"), indent=1)
 
 
 def write_table(results):
