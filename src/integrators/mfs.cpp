@@ -64,10 +64,14 @@ MfsIntegrator::MfsIntegrator(const SceneContext& context, MfsSettings settings)
     f_.push_back(splits_.back()->f());
     theta2_.push_back(splits_.back()->theta2());
   }
+  // Shadow-map nodes march towards the light at this optical-depth step (midpoint rule). 0.05 and 0.5
+  // give the same validation errors (the map's trilinear interpolation dominates); 0.25 halves the
+  // Disney cloud's precomputation against 0.05.
+  constexpr double map_step = 0.25;
   for (const Light& l : ctx_.lights) {
-    full_maps_.emplace_back(ctx_.media, ctx_.majorants, l, s_.shadow_map_resolution, 0.05);
+    full_maps_.emplace_back(ctx_.media, ctx_.majorants, l, s_.shadow_map_resolution, map_step);
     if (s_.forward_light_path)
-      reduced_maps_.emplace_back(ctx_.media, ctx_.majorants, l, s_.shadow_map_resolution, 0.05, f_);
+      reduced_maps_.emplace_back(ctx_.media, ctx_.majorants, l, s_.shadow_map_resolution, map_step, f_);
   }
   if (s_.large_angle_scatters != 0 && (s_.large_angle_scatters != 1 || ctx_.has_environment)) {
     std::vector<const PhaseSplit*> splits;
