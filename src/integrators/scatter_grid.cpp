@@ -13,7 +13,11 @@ namespace {
 
 constexpr int kBatches = 8;             // fixed: the grid must not depend on the thread count
 constexpr int kMaxWideScatters = 1024;  // photons are ended after this many wide scatters ...
-constexpr int kMaxEvents = 1 << 20;     // ... or real collisions
+constexpr int kMaxEvents = 1 << 14;     // ... or real collisions
+// Work budget: a batch stops starting photons once its collisions exceed this many per photon of the
+// batch, and its deposits are scaled by planned / traced photons (optically very thick media would
+// otherwise take hours; below the budget nothing changes).
+constexpr double kEventsPerPhoton = 512.0;
 struct Photon {
   Vec3 x, w;
   Rgb power;
@@ -110,6 +114,7 @@ ScatterGrid::ScatterGrid(const SceneContext& ctx, const std::vector<const PhaseS
   const int media_count = ctx.media.count();
 
   std::vector<std::vector<float>> batch(kBatches);
+  std::vector<double> batch_scale(kBatches, 1.0);
   tbb::parallel_for(0, kBatches, [&](int b) {
     std::vector<float>& g = batch[b];
     g.assign(node_count * kFloatsPerNode, 0.0f);
@@ -150,7 +155,10 @@ ScatterGrid::ScatterGrid(const SceneContext& ctx, const std::vector<const PhaseS
 
     const size_t begin = total * size_t(b) / kBatches, end = total * size_t(b + 1) / kBatches;
     MediumPoint mp;
-    for (size_t j = begin; j < end; ++j) {
+    const double budget = kEventsPerPhoton * double(end - begin);
+    double spent = 0.0;
+    size_t j = begin;
+    for (; j < end && spent <= budget; ++j) {
       Rng rng(s.seed ^ 0x6d756c7469706c65ull, j);
       const int pass = int(j / (sources * per_source));
       size_t source = (j / per_source) % sources;
@@ -167,7 +175,7 @@ ScatterGrid::ScatterGrid(const SceneContext& ctx, const std::vector<const PhaseS
       Vec3 x = ph.x, w = ph.w;
       double weight = 1.0;
       int order = 0;  // wide scatters so far
-      for (int events = 0; events < kMaxEvents; ++events) {
+      for (int events = 0; events < kMaxEvents; ++events, spent += 1.0) {
         bool hit = false;
         Vec3 xc;
         track(ctx.majorants, x, w, std::numeric_limits<double>::infinity(), rng,
@@ -229,6 +237,7 @@ ScatterGrid::ScatterGrid(const SceneContext& ctx, const std::vector<const PhaseS
         x = xc;
       }
     }
+    batch_scale[b] = j > begin ? double(end - begin) / double(j - begin) : 1.0;
   });
 
   // Sum the batches in order, divide by the node volume: fluence and flux.
@@ -236,7 +245,7 @@ ScatterGrid::ScatterGrid(const SceneContext& ctx, const std::vector<const PhaseS
   tbb::parallel_for(size_t(0), node_count, [&](size_t n) {
     for (int k = 0; k < kFloatsPerNode; ++k) {
       double sum = 0.0;
-      for (int b = 0; b < kBatches; ++b) sum += batch[b][n * kFloatsPerNode + k];
+      for (int b = 0; b < kBatches; ++b) sum += batch_scale[b] * batch[b][n * kFloatsPerNode + k];
       values_[n * kFloatsPerNode + k] = float(sum * inv_volume);
     }
   });
