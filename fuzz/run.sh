@@ -1,0 +1,39 @@
+#!/usr/bin/env bash
+# Runs the libFuzzer targets built in build-fuzz/ (make fuzz-build) for SECONDS each, one after the
+# other: make fuzz-smoke runs it with 60 s, make fuzz FUZZ_SECONDS=N with N. New inputs go to
+# build-fuzz/corpus/<target>/ (the committed seeds in fuzz/corpus/<target>/ are only read); a crash,
+# leak, timeout or out-of-memory input is written to build-fuzz/artifacts/<target>/ and fails the run.
+# Usage: fuzz/run.sh SECONDS [TARGET...]   (targets: scene vdb cli; default all)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+seconds=${1:?usage: fuzz/run.sh SECONDS [TARGET...]}
+shift
+targets=("$@")
+[ ${#targets[@]} -eq 0 ] && targets=(scene vdb cli)
+BUILD_FUZZ=${BUILD_FUZZ:-build-fuzz}
+export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:allocator_may_return_null=1}
+export LSAN_OPTIONS=${LSAN_OPTIONS:-suppressions=$PWD/fuzz/lsan.supp}
+export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
+for t in "${targets[@]}"; do
+  bin="$BUILD_FUZZ/bin/${t}_fuzz"
+  [ -x "$bin" ] || { echo "fuzz/run.sh: $bin not built (make fuzz-build)" >&2; exit 1; }
+  case $t in
+    vdb) max_len=400000 ;;   # the uncompressed NanoVDB seed is ~310 KB
+    *) max_len=4096 ;;
+  esac
+  dict=()
+  [ -f "fuzz/$t.dict" ] && dict=(-dict="fuzz/$t.dict")
+  mkdir -p "$BUILD_FUZZ/corpus/$t" "$BUILD_FUZZ/artifacts/$t"
+  echo "fuzz/run.sh: $t for ${seconds}s" >&2
+  # One worker; -timeout: one input over 10 s is a hang; -rss_limit_mb: memory over 2 GiB is a bug
+  # (a malloc above it, too).
+  "$bin" "$BUILD_FUZZ/corpus/$t" "fuzz/corpus/$t" "${dict[@]}" -max_total_time="$seconds" \
+    -timeout=10 -rss_limit_mb=2048 -max_len="$max_len" -print_final_stats=1 \
+    -artifact_prefix="$BUILD_FUZZ/artifacts/$t/" 2>&1 | tee "$BUILD_FUZZ/$t.log" | \
+    grep -E '^(#[0-9]+.*(INITED|DONE|pulse))|stat::|ERROR|SUMMARY|Test unit written|^==' >&2 || true
+  status=${PIPESTATUS[0]}
+  if [ "$status" -ne 0 ]; then
+    echo "fuzz/run.sh: $t FAILED (exit $status); see $BUILD_FUZZ/$t.log and $BUILD_FUZZ/artifacts/$t/" >&2
+    exit 1
+  fi
+done
