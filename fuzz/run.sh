@@ -11,14 +11,22 @@ shift
 targets=("$@")
 [ ${#targets[@]} -eq 0 ] && targets=(scene vdb cli)
 BUILD_FUZZ=${BUILD_FUZZ:-build-fuzz}
-export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:allocator_may_return_null=1}
+export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1}
 export LSAN_OPTIONS=${LSAN_OPTIONS:-suppressions=$PWD/fuzz/lsan.supp}
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
 for t in "${targets[@]}"; do
   bin="$BUILD_FUZZ/bin/${t}_fuzz"
   [ -x "$bin" ] || { echo "fuzz/run.sh: $bin not built (make fuzz-build)" >&2; exit 1; }
+  asan=$ASAN_OPTIONS
+  extra=()
   case $t in
-    vdb) max_len=400000 ;;   # the uncompressed NanoVDB seed is ~310 KB
+    # The uncompressed NanoVDB seed is ~310 KB. vdb_fuzz replaces operator new (see the file), so
+    # memory from a library's operator new may come back through its free(): not a finding.
+    # OpenVDB 10.0 itself overflows a heap buffer on some corrupt .vdb files (docs/reliability.md), so
+    # this target runs in fork mode and keeps going past crashes; fuzz/triage.sh then replays every
+    # saved input and fails only on those whose fault lies outside libopenvdb.so.
+    vdb) max_len=400000; asan=$asan:alloc_dealloc_mismatch=0
+         extra=(-fork=1 -ignore_crashes=1 -ignore_timeouts=1 -ignore_ooms=1) ;;
     *) max_len=4096 ;;
   esac
   dict=()
@@ -27,11 +35,16 @@ for t in "${targets[@]}"; do
   echo "fuzz/run.sh: $t for ${seconds}s" >&2
   # One worker; -timeout: one input over 10 s is a hang; -rss_limit_mb: memory over 2 GiB is a bug
   # (a malloc above it, too).
-  "$bin" "$BUILD_FUZZ/corpus/$t" "fuzz/corpus/$t" "${dict[@]}" -max_total_time="$seconds" \
+  ASAN_OPTIONS=$asan "$bin" "$BUILD_FUZZ/corpus/$t" "fuzz/corpus/$t" "${dict[@]}" "${extra[@]}" -max_total_time="$seconds" \
     -timeout=10 -rss_limit_mb=2048 -max_len="$max_len" -print_final_stats=1 \
     -artifact_prefix="$BUILD_FUZZ/artifacts/$t/" 2>&1 | tee "$BUILD_FUZZ/$t.log" | \
-    grep -E '^(#[0-9]+.*(INITED|DONE|pulse))|stat::|ERROR|SUMMARY|Test unit written|^==' >&2 || true
+    grep -E '^(#[0-9]+.*(INITED|DONE|pulse))|^#[0-9]+: cov|stat::|ERROR|SUMMARY|Test unit written|^==|^INFO: (fuzzed|exiting)|^Done' >&2 || true
   status=${PIPESTATUS[0]}
+  if [ ${#extra[@]} -gt 0 ]; then  # fork mode: the saved inputs decide
+    status=0
+    grep -q '^INFO: fuzzed for' "$BUILD_FUZZ/$t.log" || status=1
+    fuzz/triage.sh "$t" >&2 || status=1
+  fi
   if [ "$status" -ne 0 ]; then
     echo "fuzz/run.sh: $t FAILED (exit $status); see $BUILD_FUZZ/$t.log and $BUILD_FUZZ/artifacts/$t/" >&2
     exit 1

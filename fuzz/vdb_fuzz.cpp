@@ -7,13 +7,34 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <cstdlib>
 #include <cstring>
+#include <new>
 #include <filesystem>
 #include <fstream>
 #include <string>
 
 #include "io/vdb.h"
 #include "nimbus/error.h"
+
+// operator new as a machine with 1 GiB to spare would behave: a larger request throws std::bad_alloc.
+// OpenVDB allocates whatever a corrupt size field asks for (new char[64 GiB] in io::bloscFromStream);
+// in a normal build that is std::bad_alloc, which the loader turns into nimbus::Error, but ASan's own
+// operator new aborts on any failed allocation. Smaller requests go to malloc, which ASan still checks
+// (overflows, use after free, leaks); only new/delete mismatch detection is lost. A bad_alloc that
+// escapes the loader (an allocation nimbus sized from the file outside its guards) is a finding.
+constexpr std::size_t kMaxNew = std::size_t(1) << 30;
+void* bounded_new(std::size_t n) {
+  if (n > kMaxNew) throw std::bad_alloc();
+  if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
+  throw std::bad_alloc();
+}
+void* operator new(std::size_t n) { return bounded_new(n); }
+void* operator new[](std::size_t n) { return bounded_new(n); }
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
 
 namespace {
 
