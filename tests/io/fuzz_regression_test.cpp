@@ -77,5 +77,14 @@ TEST(FuzzRegression, SparseGridWithAHugeBBoxLoadsQuickly) {
   EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 10.0);
 }
 
+// The checksummed tiny grid of fuzz/corpus/vdb/ with its root table size set to 100000 (a targeted
+// mutation made while reviewing the loader next to the fuzz findings): the full checksum ran before
+// the structural check and read past the grid buffer (ASan: heap-buffer-overflow in CRC32).
+TEST(FuzzRegression, NanoVdbChecksumRunsAfterTheStructuralCheck) {
+  expect_clean_error("nvdb_checksum_root_table_size.nvdb");
+  const std::string msg = test::load_error(fuzz_input("nvdb_checksum_root_table_size.nvdb"));
+  EXPECT_NE(msg.find("root table overruns the buffer"), std::string::npos) << msg;
+}
+
 }  // namespace
 }  // namespace nimbus
