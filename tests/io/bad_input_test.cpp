@@ -7,6 +7,7 @@
 #include <nanovdb/util/IO.h>
 #include <nanovdb/util/OpenToNanoVDB.h>
 #include <openvdb/openvdb.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 
 #include <cmath>
@@ -149,6 +150,25 @@ TEST(BadInput, GridsWithoutActiveVoxelsAreErrors) {
   // A procedural cloud has at least 8 voxels along each axis.
   doc["media"][0]["shape"] = {{"type", "cloud"}, {"radius", 1}, {"resolution", 0}};
   EXPECT_EQ(parse_error(doc), "scene.json: /media/0/shape/resolution: must be >= 8");
+}
+
+// A scene may name any path as a volume: devices, FIFOs and directories are refused from their file
+// status, before anything is opened (opening a FIFO for reading would block until a writer comes).
+TEST(BadInput, VolumePathsThatAreNotRegularFilesAreRefusedWithoutOpening) {
+  test::ScratchDir dir("bad_volume_path");
+  const auto fifo = dir / "pipe.vdb";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"/dev/zero", "not a regular file"},
+      {fifo.string(), "not a regular file"},
+      {dir.path.string(), "is a directory"},
+  };
+  for (const auto& [path, what] : cases) {
+    nlohmann::json doc = small_scene();
+    doc["media"][0]["shape"] = {{"type", "vdb"}, {"file", path}, {"scale", 1.0}};
+    EXPECT_EQ(parse_error(doc).rfind("scene.json: /media/0/shape/file: " + path + ": " + what, 0), 0u)
+        << parse_error(doc);
+  }
 }
 
 TEST(BadInput, DegenerateCameraFramesAreErrors) {
