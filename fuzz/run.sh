@@ -25,8 +25,11 @@ for t in "${targets[@]}"; do
     # OpenVDB 10.0 itself overflows a heap buffer on some corrupt .vdb files (docs/reliability.md), so
     # this target runs in fork mode and keeps going past crashes; fuzz/triage.sh then replays every
     # saved input and fails only on those whose fault lies outside libopenvdb.so.
+    # -detect_leaks=0: OpenVDB leaks on most corrupt .vdb files (suppressed), and libFuzzer's leak
+    # check after each such input scanned the whole heap (about 1 s): 1-30 inputs/s. LeakSanitizer
+    # still runs when each fork-mode job exits, so a leak in nimbus still fails that job.
     vdb) max_len=400000; asan=$asan:alloc_dealloc_mismatch=0
-         extra=(-fork=1 -ignore_crashes=1 -ignore_timeouts=1 -ignore_ooms=1) ;;
+         extra=(-fork=1 -ignore_crashes=1 -ignore_timeouts=1 -ignore_ooms=1 -detect_leaks=0) ;;
     *) max_len=4096 ;;
   esac
   dict=()
