@@ -62,9 +62,10 @@ TEST(FuzzRegression, OpenVdbHugeAllocationsAreErrors) {
   expect_clean_error("vdb_openvdb_alloc_oom.vdb");
 }
 
-// A 300 KB NanoVDB file whose few nodes lie far apart: its bbox holds ~2^31 voxels (just within the
-// limit), and the brick max pass read every one of them through the accessor (over 10 s under the
-// fuzzer). It now reads each empty 8^3 block once, so the cost follows the data.
+// A 300 KB NanoVDB grid (stored here ZIP-compressed, the grid bytes as found) whose few nodes lie
+// far apart: its bbox holds ~2^30 voxels (within the 2^31 limit), and the brick max pass read every
+// one of them through the accessor (over 10 s under the fuzzer). It now reads each empty 8^3 block
+// once, so the cost follows the data.
 TEST(FuzzRegression, SparseGridWithAHugeBBoxLoadsQuickly) {
   const auto file = fuzz_input("nvdb_sparse_huge_bbox.nvdb");
   const auto t0 = std::chrono::steady_clock::now();
@@ -78,8 +79,9 @@ TEST(FuzzRegression, SparseGridWithAHugeBBoxLoadsQuickly) {
 }
 
 // The checksummed tiny grid of fuzz/corpus/vdb/ with its root table size set to 100000 (a targeted
-// mutation made while reviewing the loader next to the fuzz findings): the full checksum ran before
-// the structural check and read past the grid buffer (ASan: heap-buffer-overflow in CRC32).
+// mutation made while reviewing the loader next to the fuzz findings; vdb_fuzz later found the same
+// fault on its own; stored ZIP-compressed): the full checksum ran before the structural check and
+// read past the grid buffer (ASan: heap-buffer-overflow in CRC32).
 TEST(FuzzRegression, NanoVdbChecksumRunsAfterTheStructuralCheck) {
   expect_clean_error("nvdb_checksum_root_table_size.nvdb");
   const std::string msg = test::load_error(fuzz_input("nvdb_checksum_root_table_size.nvdb"));
