@@ -2,6 +2,7 @@
 // each finding). The files live in tests/data/fuzz/; every one must give a nimbus::Error that names
 // the file, quickly.
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 
 #include <chrono>
 #include <filesystem>
@@ -86,6 +87,19 @@ TEST(FuzzRegression, NanoVdbChecksumRunsAfterTheStructuralCheck) {
   expect_clean_error("nvdb_checksum_root_table_size.nvdb");
   const std::string msg = test::load_error(fuzz_input("nvdb_checksum_root_table_size.nvdb"));
   EXPECT_NE(msg.find("root table overruns the buffer"), std::string::npos) << msg;
+}
+
+// A 5 KB .vdb without grid offsets (the layout io::Stream writes) whose first grid descriptor names
+// an instance parent of 860 MB: OpenVDB allocated and zero-filled the string (out of memory in the fuzzer), as
+// the layout pre-check skipped files without offsets. It now checks the first descriptor's strings.
+TEST(FuzzRegression, StreamedOpenVdbDescriptorLengthIsChecked) {
+  rusage before{}, after{};
+  getrusage(RUSAGE_SELF, &before);
+  expect_clean_error("vdb_stream_descriptor_name_length.vdb");
+  getrusage(RUSAGE_SELF, &after);
+  EXPECT_LT(after.ru_maxrss - before.ru_maxrss, 200 * 1024) << "KB of peak memory added";
+  const std::string msg = test::load_error(fuzz_input("vdb_stream_descriptor_name_length.vdb"));
+  EXPECT_NE(msg.find("corrupt OpenVDB file: instance parent needs 861877343 bytes"), std::string::npos) << msg;
 }
 
 }  // namespace
