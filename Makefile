@@ -1,12 +1,14 @@
 # nimbus: the two commands of the README.
 #   make demo   installs missing Debian packages, builds, renders the built-in scene to out/demo.{exr,png}
 #   make test   installs missing Debian packages, builds, runs the whole suite through ctest
-# Also: make (build only), make test-fast (no statistical tests), make asan (sanitizer build + fast tests).
+# Also: make (build only), make test-fast (no statistical tests), make asan (sanitizer build + fast tests),
+# make fuzz-smoke (libFuzzer targets, 60 s each), make fuzz FUZZ_SECONDS=N (N s each): docs/reliability.md.
 BUILD ?= build
 JOBS ?= $(shell nproc)
 CMAKE_FLAGS ?=
+FUZZ_SECONDS ?= 600
 
-.PHONY: all deps configure build demo test test-fast asan bench clean
+.PHONY: all deps configure build demo test test-fast asan bench clean fuzz-build fuzz-smoke fuzz fuzz-seeds
 
 all: build
 
@@ -42,5 +44,24 @@ asan: deps
 bench: build
 	$(BUILD)/bin/bench_render
 
+# libFuzzer targets (fuzz/): clang-14, ASan + UBSan, in build-fuzz/. See docs/reliability.md.
+build-fuzz/build.ninja:
+	cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_COMPILER=clang++-14 \
+	  -DNIMBUS_FUZZ=ON -DBUILD_TESTING=OFF -DNIMBUS_BUILD_BENCH=OFF
+
+fuzz-build: deps build-fuzz/build.ninja
+	cmake --build build-fuzz -j $(JOBS) --target scene_fuzz vdb_fuzz cli_fuzz
+
+fuzz-smoke: fuzz-build
+	fuzz/run.sh 60
+
+fuzz: fuzz-build
+	fuzz/run.sh $(FUZZ_SECONDS)
+
+# Regenerates fuzz/data/tiny.{vdb,nvdb} and the volume seeds in fuzz/corpus/vdb/ (committed).
+fuzz-seeds: fuzz-build
+	cmake --build build-fuzz -j $(JOBS) --target make_seeds
+	ASAN_OPTIONS=detect_leaks=0 build-fuzz/bin/make_seeds fuzz/data fuzz/corpus/vdb
+
 clean:
-	rm -rf $(BUILD) build-asan
+	rm -rf $(BUILD) build-asan build-fuzz

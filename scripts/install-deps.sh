@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Installs every Debian package nimbus needs to build, test and validate.
+# Installs every Debian package nimbus needs to build, test, fuzz (clang-14 + its libFuzzer runtime)
+# and validate.
 # Idempotent: does nothing when everything is already present. Needs root (or sudo) on Debian 12.
 set -euo pipefail
 
@@ -9,6 +10,7 @@ packages=(
   libopenexr-dev libimath-dev libpng-dev
   libboost-iostreams-dev libtbb-dev nlohmann-json3-dev libcli11-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev
+  clang-14 libclang-rt-14-dev
   python3 python3-numpy python3-matplotlib
 )
 

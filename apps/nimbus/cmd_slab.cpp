@@ -35,6 +35,10 @@ struct SlabArgs {
 int run_slab(const SlabArgs& a) {
   if (!(a.mu_s >= 0.0) || !std::isfinite(a.mu_s)) throw Error(fmt::format("--mu-s must be >= 0 (got {})", a.mu_s));
   if (!(a.mu_a >= 0.0) || !std::isfinite(a.mu_a)) throw Error(fmt::format("--mu-a must be >= 0 (got {})", a.mu_a));
+  // Each finite, their sum (the extinction) may still overflow: 1e308 + 1e308 made an infinite
+  // sigma_t and a slab that reflected everything.
+  if (!std::isfinite(a.mu_s + a.mu_a))
+    throw Error(fmt::format("--mu-s + --mu-a must be finite (got {} + {})", a.mu_s, a.mu_a));
   if (!(a.g > -1.0 && a.g < 1.0)) throw Error(fmt::format("--g must lie in (-1, 1) (got {})", a.g));
   if (!(a.thickness > 0.0) || !std::isfinite(a.thickness)) throw Error(fmt::format("--thickness must be > 0 (got {})", a.thickness));
   if (!(a.n >= 1.0) || !std::isfinite(a.n) || a.n > 10.0) throw Error(fmt::format("--n must lie in [1, 10] (got {})", a.n));

@@ -11,6 +11,9 @@ namespace nimbus::cli {
 
 using Action = std::function<int()>;
 
+// Registers every subcommand (and --version) on `app`; parsing stores the chosen action in `action`.
+void build_app(CLI::App& app, Action& action);
+
 void add_render_command(CLI::App& app, Action& action);
 void add_compare_command(CLI::App& app, Action& action);
 void add_info_command(CLI::App& app, Action& action);

@@ -9,18 +9,9 @@
 
 int main(int argc, char** argv) {
   using namespace nimbus::cli;
-  CLI::App app{"nimbus: a renderer for forward-scattering participating media (clouds, smoke, fog, "
-               "skin, water), with the multiple-forward-scattering model judged against an unbiased "
-               "path tracer."};
-  app.require_subcommand(1);
-  app.set_version_flag("--version", "nimbus 0.1.0");
+  CLI::App app;
   Action action;
-  add_render_command(app, action);
-  add_compare_command(app, action);
-  add_info_command(app, action);
-  add_convert_command(app, action);
-  add_beam_command(app, action);
-  add_slab_command(app, action);
+  build_app(app, action);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -8,6 +8,7 @@
 #include "io/json_reader.h"
 #include "integrators/integrator.h"
 #include "io/scene_volumes.h"
+#include "media/media.h"
 #include "nimbus/render.h"
 #include "nimbus/error.h"
 #include "nimbus/scene.h"
@@ -167,7 +168,11 @@ Scene parse_scene(const nlohmann::json& doc, const std::string& name, const std:
   JsonObject root(doc, name, "");
   Scene scene;
   scene.camera = parse_camera(root.object("camera"));
-  for (JsonObject& m : root.array_of_objects("media", true)) scene.media.push_back(parse_medium(m, base_dir));
+  std::vector<JsonObject> media = root.array_of_objects("media", true);
+  // Checked before any volume is loaded or voxelised (the renderer would refuse the scene anyway).
+  if (media.size() > size_t(kMaxMedia))
+    root.fail("media", fmt::format("at most {} media (got {})", kMaxMedia, media.size()));
+  for (JsonObject& m : media) scene.media.push_back(parse_medium(m, base_dir));
   for (JsonObject& l : root.array_of_objects("lights", true)) scene.lights.push_back(parse_light(l));
   if (root.has("integrator")) scene.integrator = parse_integrator(doc["integrator"], root.object("integrator"));
   root.finish();

@@ -99,9 +99,10 @@ class DensityGrid {
   struct Data;  // owns the NanoVDB buffer, the brick array and the stats (shared by copies)
 
  private:
-  // Checks values, builds the brick max and the statistics of a loaded grid.
+  // Checks the structure (then, if asked, the file's checksum) and the values, builds the brick max
+  // and the statistics of a loaded grid.
   static DensityGrid analyse(const std::filesystem::path& file, nanovdb::GridHandle<nanovdb::HostBuffer> handle,
-                             double read_seconds);
+                             double read_seconds, bool verify_checksum = false);
   template <typename Acc>
   double trilinear(Acc& acc, const Vec3& p) const;
 
