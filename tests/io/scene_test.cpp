@@ -97,7 +97,7 @@ TEST(Scene, BadInputCatalogue) {
       {"/camera", nullptr, true, "scene.json: /camera: required field is missing"},
       {"/integrator/spp", 0, false, "scene.json: /integrator/spp: must be >= 1"},
       {"/integrator/type", "magic", false, "scene.json: /integrator/type: unknown integrator 'magic' (known: pathtrace, single, mfs, octave)"},
-      {"/integrator/tau_step", 0.1, false, "scene.json: /integrator/tau_step: unknown field for integrator 'pathtrace'"},
+      {"/integrator/tau_step", 0.1, false, "scene.json: /integrator/tau_step: unknown field (known here: max_wide_scatters, peak_fraction)"},
       {"/integrator/max_events", -1, false, "scene.json: /integrator/max_events: must be >= 0"},
       {"/media", json::object(), false, "scene.json: /media: must be an array, not an object"},
       {"/media/0", 3, false, "scene.json: /media/0: must be an object, not a number"},
