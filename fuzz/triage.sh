@@ -3,7 +3,7 @@
 # stack frame that is not the sanitizer, libFuzzer, libc or libstdc++: inside libopenvdb.so is a
 # third-party OpenVDB 10.0 defect (docs/reliability.md lists the known ones), anything else is a
 # nimbus bug and makes this script exit 1.
-# Usage: fuzz/triage.sh TARGET
+# Usage: [FUZZ_TIMEOUT=SECONDS] fuzz/triage.sh TARGET   (replay time limit, default 10; run.sh passes 30 for vdb)
 set -uo pipefail
 cd "$(dirname "$0")/.."
 t=${1:?usage: fuzz/triage.sh TARGET}
@@ -16,7 +16,7 @@ n=0
 for f in "$BUILD_FUZZ"/artifacts/"$t"/*; do
   [ -f "$f" ] || continue
   n=$((n + 1))
-  log=$("$BUILD_FUZZ/bin/${t}_fuzz" -timeout=10 -rss_limit_mb=2048 "$f" 2>&1)
+  log=$("$BUILD_FUZZ/bin/${t}_fuzz" -timeout="${FUZZ_TIMEOUT:-10}" -rss_limit_mb=2048 "$f" 2>&1)
   if ! grep -qE 'ERROR|SUMMARY|libFuzzer: timeout' <<<"$log"; then
     echo "fixed (replays cleanly): $f"
     continue
