@@ -117,6 +117,16 @@ def png(exr, out, exposure, heat_ref=None):
         subprocess.run([NIMBUS, "convert", exr, out, "--exposure", f"{exposure:.3f}"], check=True)
 
 
+def pathtrace_fit(runs, noise):
+    """Path tracing's rel RMSE against the reference ~ sqrt(c2 / spp + noise^2), its time ~ t0 + k spp,
+    fitted through the first and last of `runs` (increasing spp). Returns (c2, k, t0)."""
+    last, first = runs[-1], runs[0]
+    c2 = max(last["rel_rmse"] ** 2 - noise ** 2, 1e-12) * last["spp"]
+    k = max((last["time_s"] - first["time_s"]) / (last["spp"] - first["spp"]), 1e-9)
+    t0 = max(first["time_s"] - k * first["spp"], 0.0)
+    return c2, k, t0
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--only")
@@ -168,11 +178,7 @@ def main():
             mean, rrmse, _ = compare(out, ref)
             r["pathtrace"].append({"spp": spp, "mean_error": mean, "rel_rmse": rrmse, "time_s": t})
             print(f"{name:34s} pathtrace {spp:4d} spp  mean {mean:+.3f} rrmse {rrmse:.3f} time {t:.2f}s", flush=True)
-        # Path tracing's rel RMSE against the reference ~ sqrt(c^2 / spp + noise^2); time ~ t0 + k spp.
-        last, first = r["pathtrace"][-1], r["pathtrace"][0]
-        c2 = max(last["rel_rmse"] ** 2 - noise ** 2, 1e-12) * last["spp"]
-        k = max((last["time_s"] - first["time_s"]) / (last["spp"] - first["spp"]), 1e-9)
-        t0 = max(first["time_s"] - k * first["spp"], 0.0)
+        c2, k, t0 = pathtrace_fit(r["pathtrace"], noise)
         for label, c in r["configs"].items():
             target2 = c["rel_rmse"] ** 2 - noise ** 2
             if target2 <= 0:
@@ -247,9 +253,7 @@ def size_study():
         t = render(scene, base, {"type": "pathtrace"}, spp, out, seed=3)
         m, e, _ = compare(out, ref)
         rows["pathtrace"].append({"spp": spp, "time_s": t, "mean_error": m, "rel_rmse": e})
-    last, first = rows["pathtrace"][-1], rows["pathtrace"][0]
-    c2 = max(last["rel_rmse"] ** 2 - noise ** 2, 1e-12) * last["spp"]
-    k = max((last["time_s"] - first["time_s"]) / (last["spp"] - first["spp"]), 1e-9)
+    c2, k, _ = pathtrace_fit(rows["pathtrace"], noise)
     for label, block, spp in (("mfs 4 spp", {"type": "mfs"}, 4), ("mfs 1 spp", {"type": "mfs"}, 1),
                               ("single 4 spp", {"type": "single", "transmittance": "shadow_map"}, 4),
                               ("octave 4 spp", {"type": "octave"}, 4)):

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "core/sh.h"
+#include "core/trilinear.h"
 #include "integrators/shadow_map.h"
 #include "integrators/tracking.h"
 
@@ -105,7 +106,6 @@ ScatterGrid::ScatterGrid(const SceneContext& ctx, const std::vector<const PhaseS
   if (sources == 0 || s.photons <= 0) return;
   const size_t per_source = std::max<size_t>(1, size_t(s.photons) / sources);
   const size_t total = size_t(passes) * sources * per_source;
-  photons_traced_ = double(total);
 
   const Vec3 centre = (media_bounds.lo + media_bounds.hi) * 0.5;
   const double radius = 0.5 * extent.length() * (1.0 + 1e-9) + 1e-12;
@@ -120,19 +120,11 @@ ScatterGrid::ScatterGrid(const SceneContext& ctx, const std::vector<const PhaseS
     g.assign(node_count * kFloatsPerNode, 0.0f);
     // Splat value `v` (per channel; only channels with a non-zero entry) times the harmonics y at q.
     auto splat = [&](const Vec3& q, const double* y, const Rgb& v) {
-      int i[3];
-      double fr[3];
-      for (int a = 0; a < 3; ++a) {
-        const double u = std::clamp((q[a] - bounds_.lo[a]) / spacing_[a], 0.0, double(nodes_[a] - 1));
-        i[a] = std::min(int(u), nodes_[a] - 2);
-        fr[a] = u - i[a];
-      }
+      const TrilinearStencil st = trilinear_stencil(q, bounds_.lo, spacing_, nodes_);
       for (int k = 0; k < 8; ++k) {
-        const int dx = k & 1, dy = (k >> 1) & 1, dz = (k >> 2) & 1;
-        const double wt = (dx ? fr[0] : 1 - fr[0]) * (dy ? fr[1] : 1 - fr[1]) * (dz ? fr[2] : 1 - fr[2]);
+        const double wt = st.weight[k];
         if (wt <= 0.0) continue;
-        float* node =
-            &g[((size_t(i[2] + dz) * nodes_[1] + i[1] + dy) * nodes_[0] + i[0] + dx) * kFloatsPerNode];
+        float* node = &g[st.node[k] * kFloatsPerNode];
         for (int c = 0; c < 3; ++c) {
           if (v[c] == 0.0) continue;
           const double e = wt * v[c];
@@ -255,19 +247,10 @@ Rgb ScatterGrid::scattered(const Vec3& p, const Vec3& w_out, const std::array<Rg
   if (!bounds_.contains(p)) return Rgb(0.0);
   const int floats = 3 * coeffs_;
   double L[3 * kShMaxBands * kShMaxBands] = {};
-  int i[3];
-  double fr[3];
-  for (int a = 0; a < 3; ++a) {
-    const double u = std::clamp((p[a] - bounds_.lo[a]) / spacing_[a], 0.0, double(nodes_[a] - 1));
-    i[a] = std::min(int(u), nodes_[a] - 2);
-    fr[a] = u - i[a];
-  }
+  const TrilinearStencil st = trilinear_stencil(p, bounds_.lo, spacing_, nodes_);
   for (int k = 0; k < 8; ++k) {
-    const int dx = k & 1, dy = (k >> 1) & 1, dz = (k >> 2) & 1;
-    const double wt = (dx ? fr[0] : 1 - fr[0]) * (dy ? fr[1] : 1 - fr[1]) * (dz ? fr[2] : 1 - fr[2]);
-    const float* node =
-        &values_[((size_t(i[2] + dz) * nodes_[1] + i[1] + dy) * nodes_[0] + i[0] + dx) * floats];
-    for (int h = 0; h < floats; ++h) L[h] += wt * node[h];
+    const float* node = &values_[st.node[k] * floats];
+    for (int h = 0; h < floats; ++h) L[h] += st.weight[k] * node[h];
   }
   double y[kShMaxBands * kShMaxBands];
   sh_eval(w_out, bands_, y);

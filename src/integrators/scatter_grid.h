@@ -56,8 +56,6 @@ class ScatterGrid {
   int bands() const { return bands_; }
 
   size_t memory_bytes() const { return values_.size() * sizeof(float); }
-  const std::array<int, 3>& nodes() const { return nodes_; }
-  double photons_traced() const { return photons_traced_; }
 
  private:
   Bounds bounds_;  // of the node grid (the media's bounds padded by one spacing)
@@ -65,7 +63,6 @@ class ScatterGrid {
   Vec3 spacing_{1.0};
   int bands_ = 3, coeffs_ = 9;
   std::vector<float> values_;  // per node: channel c at [coeffs c + h]: L_lm, h = l^2 + l + m
-  double photons_traced_ = 0.0;
 };
 
 }  // namespace nimbus

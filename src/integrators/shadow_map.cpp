@@ -2,6 +2,7 @@
 
 #include <tbb/parallel_for.h>
 
+#include "core/trilinear.h"
 #include "integrators/tracking.h"
 #include "render/lights.h"
 
@@ -62,19 +63,11 @@ TransmittanceGrid::TransmittanceGrid(const SceneMedia& media, const MajorantGrid
 }
 
 Rgb TransmittanceGrid::lookup(const Vec3& p) const {
-  int i[3];
-  double f[3];
-  for (int a = 0; a < 3; ++a) {
-    const double u = std::clamp((p[a] - bounds_.lo[a]) / spacing_[a], 0.0, double(nodes_[a] - 1));
-    i[a] = std::min(int(u), nodes_[a] - 2);
-    f[a] = u - i[a];
-  }
+  const TrilinearStencil st = trilinear_stencil(p, bounds_.lo, spacing_, nodes_);
   Rgb r(0.0);
   for (int k = 0; k < 8; ++k) {
-    const int dx = k & 1, dy = (k >> 1) & 1, dz = (k >> 2) & 1;
-    const double w = (dx ? f[0] : 1 - f[0]) * (dy ? f[1] : 1 - f[1]) * (dz ? f[2] : 1 - f[2]);
-    const float* v = &values_[((size_t(i[2] + dz) * nodes_[1] + i[1] + dy) * nodes_[0] + i[0] + dx) * 3];
-    r += Rgb(v[0], v[1], v[2]) * w;
+    const float* v = &values_[st.node[k] * 3];
+    r += Rgb(v[0], v[1], v[2]) * st.weight[k];
   }
   return r;
 }
