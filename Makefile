@@ -53,7 +53,7 @@ fuzz-build: deps build-fuzz/build.ninja
 	cmake --build build-fuzz -j $(JOBS) --target scene_fuzz vdb_fuzz cli_fuzz
 
 fuzz-smoke: fuzz-build
-	fuzz/run.sh 60
+	FUZZ_SEED=1 fuzz/run.sh 60
 
 fuzz: fuzz-build
 	fuzz/run.sh $(FUZZ_SECONDS)

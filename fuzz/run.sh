@@ -3,7 +3,9 @@
 # other: make fuzz-smoke runs it with 60 s, make fuzz FUZZ_SECONDS=N with N. New inputs go to
 # build-fuzz/corpus/<target>/ (the committed seeds in fuzz/corpus/<target>/ are only read); a crash,
 # leak, timeout or out-of-memory input is written to build-fuzz/artifacts/<target>/ and fails the run.
-# Usage: fuzz/run.sh SECONDS [TARGET...]   (targets: scene vdb cli; default all)
+# Usage: [FUZZ_SEED=N] fuzz/run.sh SECONDS [TARGET...]   (targets: scene vdb cli; default all)
+# FUZZ_SEED: libFuzzer's -seed (default 0: a random seed); make fuzz-smoke passes 1 so that CI repeats the
+# same mutations from run to run (fork-mode job timing still varies), make fuzz leaves it random.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${1:?usage: fuzz/run.sh SECONDS [TARGET...]}
@@ -40,7 +42,7 @@ for t in "${targets[@]}"; do
   echo "fuzz/run.sh: $t for ${seconds}s" >&2
   # One worker; -timeout: one input over 10 s (vdb: 30 s) is a hang; -rss_limit_mb: memory over
   # 2 GiB is a bug (a malloc above it, too).
-  ASAN_OPTIONS=$asan "$bin" "$BUILD_FUZZ/corpus/$t" "fuzz/corpus/$t" "${dict[@]}" "${extra[@]}" -max_total_time="$seconds" \
+  ASAN_OPTIONS=$asan "$bin" "$BUILD_FUZZ/corpus/$t" "fuzz/corpus/$t" "${dict[@]}" "${extra[@]}" -max_total_time="$seconds" -seed="${FUZZ_SEED:-0}" \
     -timeout="$timeout" -rss_limit_mb=2048 -max_len="$max_len" -print_final_stats=1 \
     -artifact_prefix="$BUILD_FUZZ/artifacts/$t/" 2>&1 | tee "$BUILD_FUZZ/$t.log" | \
     grep -E '^(#[0-9]+.*(INITED|DONE|pulse))|^#[0-9]+: cov|stat::|ERROR|SUMMARY|Test unit written|^==|^INFO: (fuzzed|exiting)|^Done' >&2 || true

@@ -245,6 +245,7 @@ struct Walk {
   uint64_t active_voxels = 0, tiles = 0;
   uint32_t nodes[3] = {0, 0, 0};  // leaf, lower, upper
   nanovdb::CoordBBox bbox;        // of the active values; empty if none
+  std::string name;               // the grid's name, read with bounds checks
   double min = std::numeric_limits<double>::infinity(), max = -min, sum = 0;
   void add(double v, uint64_t count, const Coord& lo, int dim) {
     active_voxels += count;
@@ -336,6 +337,27 @@ Walk check_and_walk(const fs::path& file, const NanoHandle& handle) {
       if (td->mNodeOffset[l] > size || first < nodes_begin || w.nodes[l] > (size - first) / node_size)
         corrupt(fmt::format("node array at level {} overruns the buffer", l));
     }
+  }
+  // The name: nanovdb's gridName() follows a long name's blind metadata (offset and count from the
+  // file) without checks, and a short name need not be NUL-terminated in a corrupt file.
+  if (gd->mFlags & static_cast<uint32_t>(nanovdb::GridFlags::HasLongGridName)) {
+    using Meta = nanovdb::GridBlindMetaData;
+    const uint32_t count = gd->mBlindMetadataCount;
+    const int64_t meta_rel = gd->mBlindMetadataOffset;
+    if (count == 0 || meta_rel < 0 || static_cast<uint64_t>(meta_rel) > size ||
+        count > (size - static_cast<uint64_t>(meta_rel)) / sizeof(Meta))
+      corrupt("blind metadata outside the buffer");
+    const uint64_t meta_off = static_cast<uint64_t>(meta_rel) + (count - 1) * sizeof(Meta);
+    const auto* meta = reinterpret_cast<const Meta*>(base + meta_off);
+    const uint64_t name_off = meta_off + static_cast<uint64_t>(meta->mByteOffset);  // wraps if negative
+    if (meta->mDataClass != nanovdb::GridBlindDataClass::GridName || name_off >= size)
+      corrupt("long grid name outside the buffer");
+    const char* name = reinterpret_cast<const char*>(base + name_off);
+    const size_t n = strnlen(name, static_cast<size_t>(size - name_off));
+    if (n == size - name_off) corrupt("long grid name is not terminated");
+    w.name.assign(name, n);
+  } else {
+    w.name.assign(gd->mGridName, strnlen(gd->mGridName, nanovdb::GridData::MaxNameSize));
   }
   // The map: index -> world -> index must round-trip.
   const nanovdb::Vec3d p(1.5, -2.25, 3.75), q = grid.worldToIndex(grid.indexToWorld(p));
@@ -523,7 +545,7 @@ DensityGrid DensityGrid::analyse(const std::filesystem::path& file, nanovdb::Gri
   }
 
   Stats& st = data->stats;
-  st.name = grid->gridName();
+  st.name = w.name;
   st.file = file.string();
   st.active_voxels = w.active_voxels;
   st.tiles = w.tiles;

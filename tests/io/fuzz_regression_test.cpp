@@ -89,6 +89,16 @@ TEST(FuzzRegression, NanoVdbChecksumRunsAfterTheStructuralCheck) {
   EXPECT_NE(msg.find("root table overruns the buffer"), std::string::npos) << msg;
 }
 
+// A NanoVDB grid flagged as having a long name (stored in blind data) whose blind metadata offset
+// points 1 TB past the buffer, with the checksum disabled (all ones, as NanoVDB writes grids without
+// one): nanovdb's gridName() followed the offset (heap overflow read; found by make fuzz-smoke in CI).
+// The name is now read with bounds checks in the structural check.
+TEST(FuzzRegression, NanoVdbLongGridNameIsBoundsChecked) {
+  expect_clean_error("nvdb_long_grid_name_offset.nvdb");
+  const std::string msg = test::load_error(fuzz_input("nvdb_long_grid_name_offset.nvdb"));
+  EXPECT_NE(msg.find("blind metadata outside the buffer"), std::string::npos) << msg;
+}
+
 // A 5 KB .vdb without grid offsets (the layout io::Stream writes) whose first grid descriptor names
 // an instance parent of 860 MB: OpenVDB allocated and zero-filled the string (out of memory in the fuzzer), as
 // the layout pre-check skipped files without offsets. It now checks the first descriptor's strings.
