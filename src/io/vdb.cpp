@@ -241,6 +241,13 @@ NanoHandle read_nvdb_grid(const fs::path& file, FileReader& in, const NvdbEntry&
 
 // ---- structural check and statistics walk ----------------------------------------------------------
 
+// The grid in a buffer check_and_walk has accepted (magic, size, float type). GridHandle::grid<float>()
+// must not be used on file data: it follows the header's grid index by hopping mGridSize bytes (a
+// corrupt index read past the buffer; a grid read alone from a multi-grid file keeps its index too).
+const nanovdb::FloatGrid* checked_float_grid(const NanoHandle& handle) {
+  return reinterpret_cast<const nanovdb::FloatGrid*>(handle.data());
+}
+
 struct Walk {
   uint64_t active_voxels = 0, tiles = 0;
   uint32_t nodes[3] = {0, 0, 0};  // leaf, lower, upper
@@ -298,6 +305,10 @@ Walk check_and_walk(const fs::path& file, const NanoHandle& handle) {
   for (uint32_t t = 0; t < root->mTableSize; ++t) {
     const auto* tile = root->tile(t);
     const Coord o2 = tile->origin();
+    // Node origins are derived from this one by adding offsets: keep every voxel of the 4096^3 node
+    // representable (a corrupt key near INT_MAX would overflow in Coord arithmetic).
+    for (int a = 0; a < 3; ++a)
+      if (o2[a] < -detail::kMaxIndexCoord || o2[a] > detail::kMaxIndexCoord - 4096) corrupt("root tile origin out of range");
     if (!tile->isChild()) {
       if (tile->state) w.tiles++, w.add(tile->value, uint64_t(1) << 36, o2, 4096);
       continue;
@@ -414,13 +425,11 @@ DensityGrid DensityGrid::load(const std::filesystem::path& file, const std::stri
   const FileKind kind = detect_kind(file);
   NanoHandle handle = kind == FileKind::OpenVDB ? detail::load_openvdb_float_grid(file, grid_name)
                                                 : open_nvdb_grid(file, grid_name);
-  if (handle.grid<float>() == nullptr) fail(file, "not a float grid");
   const double read_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return analyse(file, std::move(handle), read_seconds, kind == FileKind::NanoVDB);
 }
 
 DensityGrid DensityGrid::from_nanovdb(nanovdb::GridHandle<nanovdb::HostBuffer> handle, const std::string& source) {
-  if (handle.grid<float>() == nullptr) fail(source, "not a float grid");
   return analyse(source, std::move(handle), 0.0);
 }
 
@@ -430,7 +439,7 @@ DensityGrid DensityGrid::analyse(const std::filesystem::path& file, nanovdb::Gri
   auto data = std::make_shared<Data>();
   data->handle = std::move(handle);
   const Walk w = check_and_walk(file, data->handle);
-  const auto* grid = data->handle.grid<float>();
+  const auto* grid = checked_float_grid(data->handle);
   // Only after the structural check: the checksum reads the root table and every node through the
   // grid's own sizes and offsets (a corrupt root table size read past the buffer; see
   // tests/io/fuzz_regression_test.cpp).
@@ -637,7 +646,7 @@ std::vector<GridInfo> inspect_nvdb_file(const fs::path& file) {
       // Float grids: read them and recount from the data itself.
       const NanoHandle h = read_nvdb_grid(file, in, e);
       const Walk w = check_and_walk(file, h);
-      const auto* grid = h.grid<float>();
+      const auto* grid = checked_float_grid(h);
       gi.active_voxels = w.active_voxels;
       gi.tiles = w.tiles;
       gi.empty = w.active_voxels == 0;

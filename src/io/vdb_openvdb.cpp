@@ -169,6 +169,15 @@ NanoHandle load_openvdb_float_grid(const std::filesystem::path& path, const std:
                              display_name(grid->getName())));
     if (grid->tree().activeVoxelCount() == 0)
       fail(path, fmt::format("grid {} is empty: no active voxels", display_name(grid->getName())));
+    // The root table's keys (origins of 4096^3 nodes and tiles): NanoVDB's converter adds node sizes to
+    // them in int32, so a corrupt key near INT_MAX would overflow.
+    for (auto it = grid->tree().root().cbeginChildAll(); it; ++it) {
+      const openvdb::Coord o = it.getCoord();
+      for (int a = 0; a < 3; ++a)
+        if (o[a] < -kMaxIndexCoord || o[a] > kMaxIndexCoord - 4096)
+          fail(path, fmt::format("grid {} has voxels at index ({}, {}, {}), beyond +-2^30",
+                                 display_name(grid->getName()), o[0], o[1], o[2]));
+    }
     // No stats or checksum: DensityGrid computes what it needs from the converted tree.
     return nanovdb::openToNanoVDB<nanovdb::HostBuffer>(*grid, nanovdb::StatsMode::BBox,
                                                        nanovdb::ChecksumMode::Disable);

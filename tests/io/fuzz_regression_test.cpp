@@ -99,6 +99,24 @@ TEST(FuzzRegression, NanoVdbLongGridNameIsBoundsChecked) {
   EXPECT_NE(msg.find("blind metadata outside the buffer"), std::string::npos) << msg;
 }
 
+// A BLOSC NanoVDB grid whose header claims another grid index: GridHandle::grid<float>() hops
+// mGridSize bytes per index to find it (heap overflow read), and the loader called it before the
+// structural check. The loader no longer uses it on file data.
+TEST(FuzzRegression, NanoVdbGridIndexIsNotFollowed) {
+  expect_clean_error("nvdb_grid_index_hop.nvdb");
+  const std::string msg = test::load_error(fuzz_input("nvdb_grid_index_hop.nvdb"));
+  EXPECT_NE(msg.find("corrupt grid data"), std::string::npos) << msg;
+}
+
+// A .vdb whose root table holds a node at an index coordinate near the int32 limit: NanoVDB's
+// converter overflowed a signed int adding the node size (UBSan). Index coordinates must now lie
+// within +-2^30.
+TEST(FuzzRegression, OpenVdbIndexCoordinatesNearIntMaxAreRefused) {
+  expect_clean_error("vdb_root_key_near_int_max.vdb");
+  const std::string msg = test::load_error(fuzz_input("vdb_root_key_near_int_max.vdb"));
+  EXPECT_NE(msg.find("beyond +-2^30"), std::string::npos) << msg;
+}
+
 // A 5 KB .vdb without grid offsets (the layout io::Stream writes) whose first grid descriptor names
 // an instance parent of 860 MB: OpenVDB allocated and zero-filled the string (out of memory in the fuzzer), as
 // the layout pre-check skipped files without offsets. It now checks the first descriptor's strings.
