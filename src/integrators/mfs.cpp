@@ -46,6 +46,7 @@ MfsSettings parse_mfs_settings(const nlohmann::json& options, const std::string&
   if (side != "camera" && side != "light") o.fail("forward_side", "must be \"camera\" or \"light\"");
   s.light_side = side == "light";
   s.path_lengthening = o.boolean("path_lengthening", s.path_lengthening);
+  s.beam_photons = int(o.integer("beam_photons", 0, 1 << 24, s.beam_photons));
   if (s.light_side) {
     s.forward_light_path = true;
     s.grid.exact_transport = true;
@@ -73,6 +74,12 @@ MfsIntegrator::MfsIntegrator(const SceneContext& context, MfsSettings settings)
     if (s_.forward_light_path)
       reduced_maps_.emplace_back(ctx_.media, ctx_.majorants, l, s_.shadow_map_resolution, map_step, f_);
   }
+  if (s_.forward_light_path && s_.beam_photons > 0 && !ctx_.lights.empty()) {
+    std::vector<const PhaseSplit*> splits;
+    for (const auto& sp : splits_) splits.push_back(sp.get());
+    beam_ = std::make_unique<BeamGrid>(ctx_, splits, f_, reduced_maps_, s_.beam_photons, s_.grid.resolution,
+                                       s_.grid.seed);
+  }
   if (s_.large_angle_scatters != 0 && (s_.large_angle_scatters != 1 || ctx_.has_environment)) {
     std::vector<const PhaseSplit*> splits;
     for (const auto& sp : splits_) splits.push_back(sp.get());
@@ -81,7 +88,7 @@ MfsIntegrator::MfsIntegrator(const SceneContext& context, MfsSettings settings)
 }
 
 size_t MfsIntegrator::memory_bytes() const {
-  size_t bytes = grid_ ? grid_->memory_bytes() : 0;
+  size_t bytes = (grid_ ? grid_->memory_bytes() : 0) + (beam_ ? beam_->memory_bytes() : 0);
   for (const auto& m : full_maps_) bytes += m.memory_bytes();
   for (const auto& m : reduced_maps_) bytes += m.memory_bytes();
   return bytes;
@@ -143,9 +150,21 @@ Rgb MfsIntegrator::radiance(const Vec3& o, const Vec3& d, Rng& rng) const {
                 const double mu = dot(d, ls.wi);
                 const Rgb T_light = full_maps_[l].lookup(p);
                 Rgb T_wide = s_.forward_light_path ? reduced_maps_[l].lookup(p) : T_light;
-                // Light-side peak depth ln(T_wide / T_light) and its path lengthening.
-                Rgb tps(0.0);
+                // Light-side peak depth ln(T_wide / T_light) and its path lengthening: from the
+                // photon-traced beam where there is one (its loss factor, and the peak depth whose
+                // spread has the beam's mean cosine), else the straight-line picture and, optionally,
+                // the corrected kernel's 1 / cosh.
+                Rgb tps(0.0), R(1.0), mean_cos(1.0);
+                const bool traced = beam_ && beam_->lookup(l, p, &R, &mean_cos);
+                const double one_minus_chi1 = 1.0 - (split.peak_moments().size() > 1 ? split.peak_moments()[1] : 1.0);
                 for (int c = 0; c < 3; ++c) {
+                  if (traced) {
+                    T_wide[c] *= R[c];
+                    tps[c] = one_minus_chi1 > 0.0
+                                 ? std::min(PhaseSplit::kTauMax, -std::log(std::max(mean_cos[c], 1e-12)) / one_minus_chi1)
+                                 : 0.0;
+                    continue;
+                  }
                   tps[c] = T_light[c] > 1e-30 ? std::max(0.0, std::log(T_wide[c] / T_light[c]))
                                               : PhaseSplit::kTauMax;
                   if (s_.forward_light_path && s_.path_lengthening && T_wide[c] > 0.0)

@@ -12,6 +12,9 @@
 //  - the wide term: the FIRST wide scatter of the path happens at y; light_path "forward" lets the light
 //    reach y through peak scatters only (T_light' with the reduced extinction, direction blur of the
 //    light side neglected), "beer_lambert" (paper-faithful) only unscattered (T_light = exp(-tau_t));
+//    with beam_photons > 0 (default) T_light' is corrected by the photon-traced peak-only beam
+//    (BeamGrid: lengthened paths, light leaving through the medium's sides) and the peak term's angular
+//    spread is the beam's measured mean cosine;
 //  - the peak term: paths with no wide scatter at all (the light seen through the forward peak: silver
 //    linings), first scatter at y, light unscattered before it.
 // Paths with two or more wide scatters (large_angle_scatters K > 1, default all): the light that has
@@ -41,6 +44,7 @@ struct MfsSettings {
   bool gaussian = false;           // propagator: "gsa" (false) or "gaussian" (Gaussian stand-in for the peak)
   double peak_fraction = -1.0;     // f in [0, 0.99]; < 0: "auto" (g^2 per medium)
   bool path_lengthening = false;   // the 1 / cosh loss on paths lengthened by peak deflections
+  int beam_photons = 1 << 15;      // per light, for the peak-only beam grid (BeamGrid); 0: straight beams
   bool light_side = false;        // forward_side "light": peak scatters on the light's side, exact camera leg
   int large_angle_scatters = -1;  // K: at most K wide scatters per path (0: none, the peak only); -1 = "all"
   int shadow_map_resolution = 64;
@@ -57,6 +61,7 @@ class MfsIntegrator final : public Integrator {
   Rgb radiance(const Vec3& o, const Vec3& d, Rng& rng) const;
   const PhaseSplit& split(int medium) const { return *splits_[medium]; }
   const ScatterGrid* scatter_grid() const { return grid_.get(); }
+  const BeamGrid* beam_grid() const { return beam_.get(); }
   // Bytes held by the deep shadow maps and the scatter grid.
   size_t memory_bytes() const;
 
@@ -68,6 +73,7 @@ class MfsIntegrator final : public Integrator {
   std::vector<double> theta2_;                               // per medium peak's mean square angle
   std::vector<TransmittanceGrid> full_maps_, reduced_maps_;  // per light
   std::unique_ptr<ScatterGrid> grid_;                        // wide scatters 2 .. K (null for K = 1)
+  std::unique_ptr<BeamGrid> beam_;                           // the peak-only beams' correction (or null)
 };
 
 }  // namespace nimbus

@@ -65,4 +65,41 @@ class ScatterGrid {
   std::vector<float> values_;  // per node: channel c at [coeffs c + h]: L_lm, h = l^2 + l + m
 };
 
+class TransmittanceGrid;
+
+// The lights' peak-only beams (light that has not yet scattered widely) as they really travel, against
+// the straight-line picture `mfs` uses for them: from the light's entry, T_wide = exp(-int (sigma_a +
+// (1 - f) sigma_s)) along the straight line (the reduced shadow map), as if every peak scatter kept the
+// light on its line. Peak scatters deflect it: its paths are longer (more absorption and wide
+// scattering on the way, the corrected kernel's 1 / cosh loss), and near a medium's sides it spreads out
+// of the medium and into its shadow. Per light and node:
+//     R(x) = phi_peak(x) / (phi_0(x) T_wide(x)),
+// phi_peak the fluence of the peak-only light, estimated by photons traced through the true medium:
+// flights end at peak scatters only (rate sum_m f_m sigma_s,m; the new direction from P_peak), while
+// absorption and wide scatters are a continuous loss exp(-int sigma_loss) on the photon's weight, so in
+// a uniform medium a photon's weight depends only on its path length. Track-length deposits are each
+// divided by the model phi_0 T_wide at the deposit point (phi_0: the unattenuated fluence, the
+// irradiance or I / r^2), and the same photon is deposited once more undeflected (the model itself, with
+// the same emission: a control variate), so R = traced / straight is 1 wherever nothing deflects the
+// light. Photons enter through a stratified disc or cone (the R2 sequence). The traced deposits also
+// carry the cosine to the straight direction from the light: the beam's mean cosine, which sets the
+// angular spread `mfs` gives the peak-only light. `mfs` multiplies T_wide by R.
+class BeamGrid {
+ public:
+  // reduced_maps[l]: light l's T_wide; photons: per light; resolution as ScatterGridSettings.
+  BeamGrid(const SceneContext& ctx, const std::vector<const PhaseSplit*>& splits,
+           const std::vector<double>& peak_fraction, const std::vector<TransmittanceGrid>& reduced_maps,
+           int photons, int resolution, uint64_t seed);
+  // R for light `light` at p (trilinear between nodes) and the peak-only light's mean cosine to the
+  // straight direction from the light; false (nothing written) outside the grid and for other lights.
+  bool lookup(size_t light, const Vec3& p, Rgb* factor, Rgb* mean_cosine) const;
+  size_t memory_bytes() const;
+
+ private:
+  Bounds bounds_;
+  std::array<int, 3> nodes_{2, 2, 2};
+  Vec3 spacing_{1.0};
+  std::vector<std::vector<float>> values_;  // per light and node: traced, traced x cosine, straight (rgb)
+};
+
 }  // namespace nimbus

@@ -7,6 +7,7 @@
 
 #include "integrators/mfs.h"
 #include "integrators/octave.h"
+#include "integrators/shadow_map.h"
 #include "integrators/single.h"
 #include "nimbus/error.h"
 #include "nimbus/render.h"
@@ -166,6 +167,10 @@ TEST(Mfs, OptionsAreValidatedStrictly) {
   EXPECT_NO_THROW(parse(R"({"photon_transport": "similarity", "forward_side": "light", "scatter_grid_bands": 2,
                             "path_lengthening": true})"));
   EXPECT_THROW(parse(R"({"path_lengthening": 1})"), Error);
+  EXPECT_NO_THROW(parse(R"({"beam_photons": 0})"));
+  EXPECT_NO_THROW(parse(R"({"beam_photons": 100000})"));
+  EXPECT_THROW(parse(R"({"beam_photons": -1})"), Error);
+  EXPECT_THROW(parse(R"({"beam_photons": 1e9})"), Error);
   EXPECT_THROW(parse(R"({"photon_transport": "fast"})"), Error);
   EXPECT_THROW(parse(R"({"forward_side": "both"})"), Error);
   EXPECT_THROW(parse(R"({"scatter_grid_bands": 7})"), Error);
@@ -288,6 +293,78 @@ TEST(Mfs, PeakOnlyPathsMatchThePathTracer) {
   std::printf("peak-only paths: mfs %.5f pathtrace %.5f\n", m[0], ref[0]);
   EXPECT_GT(ref[0], 0.0);
   EXPECT_NEAR(m[0], ref[0], 0.05 * ref[0]);
+}
+
+// The peak-only beam grid's normalisation: with nothing to deflect the light (no scattering, only
+// absorption) the traced beam is the straight beam, so T_wide (the shadow map) times R must be the
+// exact transmittance, and R and the mean cosine 1, for a directional light and a point light.
+TEST(Mfs, BeamGridReproducesTheStraightBeamWithoutDeflection) {
+  const Scene scene = test::scene_from_json("{" + test::camera_json(8, 8) + R"(,
+    "media": [{"shape": {"type": "box", "min": [-1, -1, -1], "max": [1, 1, 1]}, "sigma_s": 0.0,
+               "sigma_a": [0.5, 1.0, 1.5], "phase": {"type": "hg", "g": 0.9}}],
+    "lights": [{"type": "directional", "direction": [0.3, 1, -0.2], "irradiance": 2.0},
+               {"type": "point", "position": [0.5, -1.8, 0.7], "intensity": 3.0}]})");
+  const SceneContext ctx(scene);
+  MfsSettings ms = parse_mfs_settings(nlohmann::json::object(), "test", true);
+  ms.large_angle_scatters = 1;
+  ms.grid.max_wide_scatters = 1;
+  MfsIntegrator mfs(ctx, ms);
+  ASSERT_NE(mfs.beam_grid(), nullptr);
+  const Bounds box{Vec3(-1.0), Vec3(1.0)};
+  const TransmittanceGrid maps[2] = {TransmittanceGrid(ctx.media, ctx.majorants, ctx.lights[0], 64, 0.25, {0.81}),
+                                     TransmittanceGrid(ctx.media, ctx.majorants, ctx.lights[1], 64, 0.25, {0.81})};
+  Rng rng(3, 0);
+  double err_map = 0.0, err_traced = 0.0;
+  int n = 0;
+  for (size_t l = 0; l < 2; ++l)
+    for (int i = 0; i < 200; ++i) {
+      const Vec3 p(1.9 * rng.uniform() - 0.95, 1.9 * rng.uniform() - 0.95, 1.9 * rng.uniform() - 0.95);
+      // Exact: the path towards the light inside the box.
+      const Vec3 to_light = l == 0 ? -normalize(Vec3(0.3, 1, -0.2)) : normalize(Vec3(0.5, -1.8, 0.7) - p);
+      const double tmax = l == 0 ? 1e9 : (Vec3(0.5, -1.8, 0.7) - p).length();
+      double t0, t1;
+      ASSERT_TRUE(box.intersect(p, to_light, 0.0, tmax, &t0, &t1));
+      Rgb R, mu;
+      ASSERT_TRUE(mfs.beam_grid()->lookup(l, p, &R, &mu));
+      const Rgb T_map = maps[l].lookup(p);
+      for (int c = 0; c < 3; ++c) {
+        const double exact = std::exp(-(0.5 + 0.5 * c) * (t1 - t0));
+        err_map += std::abs(T_map[c] / exact - 1.0);
+        err_traced += std::abs(T_map[c] * R[c] / exact - 1.0);
+        ++n;
+        EXPECT_NEAR(T_map[c] * R[c], exact, 0.06 * exact) << "light " << l << " channel " << c;
+        EXPECT_NEAR(mu[c], 1.0, 1e-6);
+        EXPECT_NEAR(R[c], 1.0, 1e-6);  // the traced and the straight deposits are the same
+      }
+    }
+  std::printf("straight beam: mean |relative error| shadow map %.4f, shadow map x R %.4f\n", err_map / n,
+              err_traced / n);
+  EXPECT_LT(err_traced / n, 0.015);
+}
+
+// Peak-only paths in a backlit sphere of optical radius 6: the straight-line beam ignores that peak
+// deflections lengthen the paths and carry light out through the sides (+20 % here); the traced beam
+// accounts for both.
+TEST(Mfs, ThickPeakOnlyPathsMatchThePathTracerWithTheTracedBeam) {
+  Scene scene = test::scene_from_json("{" + test::camera_json(24, 24, 40.0) + R"(,
+    "media": [{"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1}, "sigma_s": 6.0, "sigma_a": 0.06,
+               "phase": {"type": "hg", "g": 0.85}}],
+    "lights": [{"type": "directional", "direction": [0.15, -1, 0.1], "irradiance": 1.0}]})");
+  scene.integrator.type = "pathtrace";
+  scene.integrator.spp = 256;
+  scene.integrator.options = {{"max_wide_scatters", 0}};
+  const RenderResult pt = render(scene, RenderOptions{});
+  const Rgb ref = image_mean(pt.image);
+  scene.integrator.type = "mfs";
+  scene.integrator.spp = 4;
+  scene.integrator.options = {{"large_angle_scatters", 0}};
+  const Rgb traced = image_mean(render(scene, RenderOptions{}).image);
+  scene.integrator.options = {{"large_angle_scatters", 0}, {"beam_photons", 0}};
+  const Rgb straight = image_mean(render(scene, RenderOptions{}).image);
+  std::printf("thick peak-only paths: mfs traced beam %.5f straight %.5f pathtrace %.5f\n", traced[0],
+              straight[0], ref[0]);
+  EXPECT_NEAR(traced[0], ref[0], 0.08 * ref[0]);
+  EXPECT_LT(std::abs(traced[0] - ref[0]), std::abs(straight[0] - ref[0]));
 }
 
 // A point light (inside the media's bounding sphere, so photons leave it in every direction) and
