@@ -64,19 +64,31 @@ void BM_MfsCloudPrecompute(benchmark::State& s) {
   run(s, "disney_cloud.json", cfg, 4, 0);
 }
 
+// The parts of the precomputation on the cloud (4 x 3 image, 2 threads), added one at a time:
+// range(0) = 0: scene set-up, phase-split tables and shadow maps (K = 1, no beam grid); 1: + the beam
+// grid (default photons); 2: + the scatter grid (the default mfs).
+void BM_MfsCloudSetupParts(benchmark::State& s) {
+  nlohmann::json cfg = kMfs;
+  if (s.range(0) < 2) cfg["large_angle_scatters"] = 1;
+  if (s.range(0) < 1) cfg["beam_photons"] = 0;
+  run(s, "disney_cloud.json", cfg, 4, 2);
+}
+
 // Memory of the precomputed grids (reported as counters; the timing is the construction).
 void BM_MfsCloudMemory(benchmark::State& state) {
   const nimbus::Scene scene = scene_with("disney_cloud.json", kMfs, 4);
   const nimbus::SceneContext ctx(scene);
-  size_t grid_bytes = 0, total_bytes = 0;
+  size_t grid_bytes = 0, beam_bytes = 0, total_bytes = 0;
   for (auto _ : state) {
     const nimbus::MfsIntegrator mfs(ctx,
                                     nimbus::parse_mfs_settings(scene.integrator.options, "bench", false));
     grid_bytes = mfs.scatter_grid()->memory_bytes();
+    beam_bytes = mfs.beam_grid() ? mfs.beam_grid()->memory_bytes() : 0;
     total_bytes = mfs.memory_bytes();
     benchmark::DoNotOptimize(grid_bytes);
   }
   state.counters["scatter_grid_MB"] = double(grid_bytes) / 1e6;
+  state.counters["beam_grid_MB"] = double(beam_bytes) / 1e6;
   state.counters["all_grids_MB"] = double(total_bytes) / 1e6;
 }
 
@@ -109,6 +121,7 @@ BENCHMARK(BM_MfsCloudPrecompute)
     ->Args({32, 1 << 16})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
+BENCHMARK(BM_MfsCloudSetupParts)->DenseRange(0, 2)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_MfsCloudMemory)->Iterations(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace

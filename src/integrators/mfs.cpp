@@ -36,7 +36,13 @@ MfsSettings parse_mfs_settings(const nlohmann::json& options, const std::string&
   }
   s.grid.max_wide_scatters = std::max(0, s.large_angle_scatters);
   s.grid.photons = int(o.integer("photons", 1, 1 << 26, s.grid.photons));
-  s.grid.resolution = int(o.integer("scatter_grid_resolution", 4, 96, s.grid.resolution));
+  if (o.has("scatter_grid_resolution") && o.raw("scatter_grid_resolution").is_string()) {
+    if (o.string("scatter_grid_resolution") != "auto")
+      o.fail("scatter_grid_resolution", "must be \"auto\" or an integer in [4, 96]");
+    s.grid.resolution = 0;
+  } else {
+    s.grid.resolution = int(o.integer("scatter_grid_resolution", 4, 96, s.grid.resolution));
+  }
   s.grid.bands = int(o.integer("scatter_grid_bands", 1, kShMaxBands, s.grid.bands));
   const std::string transport = o.string("photon_transport", "exact");
   if (transport != "similarity" && transport != "exact")
@@ -73,6 +79,22 @@ MfsIntegrator::MfsIntegrator(const SceneContext& context, MfsSettings settings)
     full_maps_.emplace_back(ctx_.media, ctx_.majorants, l, s_.shadow_map_resolution, map_step);
     if (s_.forward_light_path)
       reduced_maps_.emplace_back(ctx_.media, ctx_.majorants, l, s_.shadow_map_resolution, map_step, f_);
+  }
+  if (s_.grid.resolution <= 0) {
+    // "auto": cells of at most ~1.6 optical depths at the medium's typical extinction (the mean of the
+    // majorant grid's non-empty cells), 32 to 64 nodes along the longest axis: 32 up to an optical size
+    // of ~50 across. (A uniform medium's whole extinction; a cloud's dense core counts less.)
+    const Bounds b = ctx_.media.bounds();
+    double sum = 0.0;
+    size_t cells = 0;
+    const auto res = ctx_.majorants.resolution();
+    for (int z = 0; z < res[2]; ++z)
+      for (int y = 0; y < res[1]; ++y)
+        for (int x = 0; x < res[0]; ++x)
+          if (const double m = ctx_.majorants.cell_majorant(x, y, z); m > 0.0) sum += m, ++cells;
+    const Vec3 e = b.empty() ? Vec3(0.0) : b.hi - b.lo;
+    const double across = cells > 0 ? std::max({e.x, e.y, e.z}) * sum / double(cells) : 0.0;
+    s_.grid.resolution = std::isfinite(across) ? int(std::clamp(std::ceil(across / 1.6), 32.0, 64.0)) : 64;
   }
   if (s_.forward_light_path && s_.beam_photons > 0 && !ctx_.lights.empty()) {
     std::vector<const PhaseSplit*> splits;

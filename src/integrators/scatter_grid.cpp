@@ -106,7 +106,7 @@ ScatterGrid::ScatterGrid(const SceneContext& ctx, const std::vector<const PhaseS
     return;
   }
   const Vec3 extent = media_bounds.hi - media_bounds.lo;
-  layout_nodes(media_bounds, s.resolution, &bounds_, &nodes_, &spacing_);
+  layout_nodes(media_bounds, s.resolution > 0 ? s.resolution : 32, &bounds_, &nodes_, &spacing_);
   const size_t node_count = size_t(nodes_[0]) * nodes_[1] * nodes_[2];
   values_.assign(node_count * 3 * coeffs_, 0.0f);
   // With K = 1 only the environment's unscattered-by-wide light is needed (see the header).

@@ -35,7 +35,7 @@ namespace nimbus {
 
 struct ScatterGridSettings {
   int photons = 1 << 18;        // per channel pass, shared among the lights
-  int resolution = 32;          // nodes along the longest axis of the media's bounds
+  int resolution = 0;           // nodes along the longest axis of the media's bounds; 0: "auto" (mfs)
   int max_wide_scatters = 0;    // K: flights after wide scatter 1 .. K-1 are kept; 0 = all orders
   bool exact_transport = true;  // photons in the true medium (every collision; scatters classified peak
                                 // or wide by their share) or (false) in the similarity medium
