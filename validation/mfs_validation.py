@@ -146,6 +146,7 @@ def main():
     results_path = os.path.join(DOCS, "render_results.json")
     results = json.load(open(results_path)) if os.path.exists(results_path) else {}
     if args.tables:
+        size_table()
         write_table(results)
         return plots(results)
     for name, (scene, base, ref_spp) in suite().items():
@@ -267,11 +268,34 @@ def size_study():
         print(f"160x120 {label:14s} mean {m:+.3f} rrmse {e:.3f} time {t:.1f}s  pathtrace needs {need:.0f} spp "
               f"= {k * need:.0f}s: {k * need / t:.1f}x", flush=True)
     json.dump(rows, open(os.path.join(DOCS, "render_size_study.json"), "w"), indent=1)
+    size_table()
+
+
+def size_table():
+    """The size study's table, between the markers <!-- size --> in docs/validation/render.md."""
+    path = os.path.join(DOCS, "render_size_study.json")
+    if not os.path.exists(path):
+        return
+    rows = json.load(open(path))
+    pt = rows["pathtrace"]
+    lines = [f"Reference pathtrace 1024 spp (its own noise {rows['reference_noise_rel_rmse']:.1%} rel RMSE); path "
+             "tracing at " + ", ".join(str(p["spp"]) for p in pt[:-1]) + f" and {pt[-1]['spp']} spp took " +
+             ", ".join(f"{p['time_s']:.1f} s ({p['rel_rmse']:.0%})" for p in pt) + ".", "",
+             "| integrator | time [s] | mean error | rel RMSE | pathtrace spp for the same rel RMSE | its time [s] "
+             "| speed-up |", "|---|---|---|---|---|---|---|"]
+    for label, c in rows["configs"].items():
+        lines.append(f"| {label} | {c['time_s']:.1f} | {c['mean_error']:+.1%} | {c['rel_rmse']:.1%} | "
+                     f"{c['pathtrace_spp']:.0f} | {c['pathtrace_time_s']:.1f} | {c['speedup']:.1f}x |")
+    doc = os.path.join(DOCS, "render.md")
+    d = open(doc).read()
+    a, b = d.find("<!-- size -->"), d.find("<!-- /size -->")
+    if a >= 0 and b > a:
+        open(doc, "w").write(d[:a] + "<!-- size -->\n" + "\n".join(lines) + "\n" + d[b:])
 
 
 def write_table(results):
-    lines = ["| scene | ref noise | " + " | ".join(l for l, _, _ in CONFIGS[:1] + CONFIGS[11:12]) +
-             " | mfs time [s] | pathtrace equal-error time [s] | speed-up |", "|---|---|---|---|---|---|---|"]
+    lines = ["| scene | ref noise | mfs | octave |" +
+             " mfs time [s] | pathtrace equal-error time [s] | speed-up |", "|---|---|---|---|---|---|---|"]
     for name in suite():
         if name not in results:
             continue
