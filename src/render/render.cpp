@@ -4,6 +4,8 @@
 
 #include <chrono>
 #include <cmath>
+#include <memory>
+#include <optional>
 
 #include <fmt/format.h>
 #include <tbb/blocked_range.h>
@@ -34,8 +36,16 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
   if (options.threads < 0) throw Error("threads must be >= 0");
   if (options.tile_size < 1) throw Error("tile size must be >= 1");
 
-  const SceneContext context(scene);
-  const auto integrator = make_integrator(settings.type, settings, context);
+  // Every parallel part, the integrator's precomputation (shadow maps, photon grids) included, runs in
+  // an arena of the requested size.
+  const int threads = options.threads > 0 ? options.threads : tbb::this_task_arena::max_concurrency();
+  tbb::task_arena arena(threads);
+  std::optional<SceneContext> context_storage;
+  std::unique_ptr<Integrator> integrator;
+  arena.execute([&] {
+    context_storage.emplace(scene);
+    integrator = make_integrator(settings.type, settings, *context_storage);
+  });
 
   RenderResult result;
   result.integrator = settings.type;
@@ -92,8 +102,6 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
     if (options.progress) options.progress(done, result.tiles_total, total_samples);
   };
 
-  const int threads = options.threads > 0 ? options.threads : tbb::this_task_arena::max_concurrency();
-  tbb::task_arena arena(threads);
   arena.execute([&] {
     tbb::parallel_for(tbb::blocked_range<int64_t>(0, result.tiles_total, 1),
                       [&](const tbb::blocked_range<int64_t>& r) {
