@@ -53,6 +53,7 @@ MfsSettings parse_mfs_settings(const nlohmann::json& options, const std::string&
   s.light_side = side == "light";
   s.path_lengthening = o.boolean("path_lengthening", s.path_lengthening);
   s.beam_photons = int(o.integer("beam_photons", 0, 1 << 24, s.beam_photons));
+  s.light_blur = o.boolean("light_blur", s.light_blur);
   if (s.light_side) {
     s.forward_light_path = true;
     s.grid.exact_transport = true;
@@ -202,8 +203,12 @@ Rgb MfsIntegrator::radiance(const Vec3& o, const Vec3& d, Rng& rng) const {
                   continue;
                 }
                 for (int c = 0; c < 3; ++c) {
+                  // The first wide scatter: the beam arrives spread by its light-side peak depth, the
+                  // scattered light is spread again by the camera-side one; on the sphere these
+                  // convolutions multiply the Legendre moments, so the depths add.
                   if (s_.large_angle_scatters != 0)
-                    Li[c] += ls.weight[c] * (1.0 - f) * split.wide_eff(tp[c], mu) * T_wide[c];
+                    Li[c] += ls.weight[c] * (1.0 - f) * split.wide_eff(tp[c] + (s_.light_blur ? tps[c] : 0.0), mu) *
+                             T_wide[c];
                   if (s_.forward_light_path) {
                     // Paths without a wide scatter, counted at their last peak scatter (here): the light's
                     // forward-scattered beam (total T_wide, spread by the light-side peak depth

@@ -10,13 +10,15 @@
 //     exp(-tau_r)
 // with mu the cosine between the light's and the camera-bound propagation directions:
 //  - the wide term: the FIRST wide scatter of the path happens at y; light_path "forward" lets the light
-//    reach y through peak scatters only (T_light' with the reduced extinction, direction blur of the
-//    light side neglected), "beer_lambert" (paper-faithful) only unscattered (T_light = exp(-tau_t));
+//    reach y through peak scatters only (T_light' with the reduced extinction; the beam's angular spread on the
+//    light side blurs P_wide_eff further: its peak depth adds to tau_p, option light_blur), "beer_lambert"
+//    (paper-faithful) only unscattered (T_light = exp(-tau_t));
 //    with beam_photons > 0 (default) T_light' is corrected by the photon-traced peak-only beam
-//    (BeamGrid: lengthened paths, light leaving through the medium's sides) and the peak term's angular
-//    spread is the beam's measured mean cosine;
+//    (BeamGrid: lengthened paths, light leaving through the medium's sides) and the light-side angular
+//    spread is the one with the beam's measured mean cosine;
 //  - the peak term: paths with no wide scatter at all (the light seen through the forward peak: silver
-//    linings), first scatter at y, light unscattered before it.
+//    linings), counted at their last peak scatter at y: the light's forward beam (its light-side
+//    spread), then straight to the camera with the plain transmittance.
 // Paths with two or more wide scatters (large_angle_scatters K > 1, default all): the light that has
 // already scattered widely 1 .. K-1 times comes from a photon-traced fluence-and-flux grid
 // (integrators/scatter_grid.h) and takes its last wide scatter at y:
@@ -45,6 +47,7 @@ struct MfsSettings {
   double peak_fraction = -1.0;     // f in [0, 0.99]; < 0: "auto" (g^2 per medium)
   bool path_lengthening = false;   // the 1 / cosh loss on paths lengthened by peak deflections
   int beam_photons = 1 << 15;      // per light, for the peak-only beam grid (BeamGrid); 0: straight beams
+  bool light_blur = true;          // the first wide scatter sees the beam's light-side angular spread
   bool light_side = false;        // forward_side "light": peak scatters on the light's side, exact camera leg
   int large_angle_scatters = -1;  // K: at most K wide scatters per path (0: none, the peak only); -1 = "all"
   int shadow_map_resolution = 64;
