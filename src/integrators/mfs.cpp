@@ -54,6 +54,7 @@ MfsSettings parse_mfs_settings(const nlohmann::json& options, const std::string&
   s.path_lengthening = o.boolean("path_lengthening", s.path_lengthening);
   s.beam_photons = int(o.integer("beam_photons", 0, 1 << 24, s.beam_photons));
   s.light_blur = o.boolean("light_blur", s.light_blur);
+  s.step_growth = o.number("step_growth", 0.0, 100.0, s.step_growth);
   if (s.light_side) {
     s.forward_light_path = true;
     s.grid.exact_transport = true;
@@ -141,7 +142,9 @@ Rgb MfsIntegrator::radiance(const Vec3& o, const Vec3& d, Rng& rng) const {
   Rgb L(0.0), T_full(1.0), T_red(1.0), tau_p(0.0), theta_p(0.0), tau_red(0.0);
   const double jitter = rng.uniform();
   MediumPoint mp;
-  march(ctx_.majorants, o, d, std::numeric_limits<double>::infinity(), s_.tau_step, jitter,
+  // Steps grow with the camera-side reduced depth: tau_step (1 + step_growth tau_red).
+  march_growing(ctx_.majorants, o, d, std::numeric_limits<double>::infinity(), s_.tau_step, jitter,
+        [&] { return 1.0 + s_.step_growth * max_component(tau_red); },
         [&](const Vec3& p, double, double dt) {
           ctx_.media.eval(p, &mp);
           Rgb sigma_peak(0.0), sigma_theta(0.0);

@@ -42,6 +42,7 @@ namespace nimbus {
 
 struct MfsSettings {
   double tau_step = 0.1;           // optical depth per march step (against the majorant)
+  double step_growth = 1.0;        // steps of tau_step (1 + step_growth tau_red), tau_red: camera-side
   bool forward_light_path = true;  // light_path: "forward" (true) or "beer_lambert"
   bool gaussian = false;           // propagator: "gsa" (false) or "gaussian" (Gaussian stand-in for the peak)
   double peak_fraction = -1.0;     // f in [0, 0.99]; < 0: "auto" (g^2 per medium)

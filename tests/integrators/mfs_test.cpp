@@ -172,6 +172,8 @@ TEST(Mfs, OptionsAreValidatedStrictly) {
   EXPECT_THROW(parse(R"({"beam_photons": -1})"), Error);
   EXPECT_THROW(parse(R"({"beam_photons": 1e9})"), Error);
   EXPECT_NO_THROW(parse(R"({"light_blur": false})"));
+  EXPECT_NO_THROW(parse(R"({"step_growth": 0})"));
+  EXPECT_THROW(parse(R"({"step_growth": -1})"), Error);
   EXPECT_THROW(parse(R"({"light_blur": "yes"})"), Error);
   EXPECT_THROW(parse(R"({"photon_transport": "fast"})"), Error);
   EXPECT_THROW(parse(R"({"forward_side": "both"})"), Error);
@@ -394,6 +396,24 @@ TEST(Mfs, FirstWideScatterSeesTheBeamsSpread) {
               collimated[0], ref[0]);
   EXPECT_NEAR(blurred[0], ref[0], 0.10 * ref[0]);
   EXPECT_LT(std::abs(blurred[0] - ref[0]), 0.7 * std::abs(collimated[0] - ref[0]));
+}
+
+// Steps that grow with the camera-side depth (the default) give the image of fixed steps: the light
+// from deep in is attenuated and blurred, and the jittered march stays unbiased.
+TEST(Mfs, GrowingStepsMatchFixedSteps) {
+  Scene scene = test::scene_from_json("{" + test::camera_json(24, 24, 40.0) + R"(,
+    "media": [{"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1}, "sigma_s": 10.0, "sigma_a": 0.1,
+               "phase": {"type": "hg", "g": 0.85}}],
+    "lights": [{"type": "directional", "direction": [-1, 0.3, 0.2], "irradiance": 1.0},
+               {"type": "environment", "radiance": 0.1}]})");
+  scene.integrator.type = "mfs";
+  scene.integrator.spp = 4;
+  const Image grown = render(scene, RenderOptions{}).image;
+  scene.integrator.options = {{"step_growth", 0.0}};
+  const Image fixed = render(scene, RenderOptions{}).image;
+  const Rgb a = image_mean(grown), b = image_mean(fixed);
+  std::printf("growing steps %.5f, fixed steps %.5f\n", a[0], b[0]);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(a[c], b[c], 0.01 * b[c]) << c;
 }
 
 // A point light (inside the media's bounding sphere, so photons leave it in every direction) and
