@@ -35,6 +35,7 @@ CONFIGS = [  # (label, integrator block, spp)
     ("mfs L1 grid", {"type": "mfs", "scatter_grid_bands": 2}, 4),
     ("mfs straight beam", {"type": "mfs", "beam_photons": 0}, 4),
     ("mfs collimated beam", {"type": "mfs", "light_blur": False}, 4),
+    ("mfs filtered lookups", {"type": "mfs", "filtered_lookups": True}, 4),
     ("mfs path lengthening", {"type": "mfs", "path_lengthening": True}, 4),
     ("mfs beer_lambert", {"type": "mfs", "light_path": "beer_lambert"}, 4),
     ("mfs gaussian", {"type": "mfs", "propagator": "gaussian"}, 4),

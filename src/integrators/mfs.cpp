@@ -55,6 +55,7 @@ MfsSettings parse_mfs_settings(const nlohmann::json& options, const std::string&
   s.beam_photons = int(o.integer("beam_photons", 0, 1 << 24, s.beam_photons));
   s.light_blur = o.boolean("light_blur", s.light_blur);
   s.step_growth = o.number("step_growth", 0.0, 100.0, s.step_growth);
+  s.filtered_lookups = o.boolean("filtered_lookups", s.filtered_lookups);
   if (s.light_side) {
     s.forward_light_path = true;
     s.grid.exact_transport = true;
@@ -140,12 +141,15 @@ Rgb MfsIntegrator::radiance(const Vec3& o, const Vec3& d, Rng& rng) const {
   // theta_p: the accumulated angular diffusion int theta2 dtau_p (per-component mean square angle of the
   // peaks), tau_red = -ln T_red: together the path-lengthening factor 1 / cosh(sqrt(theta_p tau_red)).
   Rgb L(0.0), T_full(1.0), T_red(1.0), tau_p(0.0), theta_p(0.0), tau_red(0.0);
+  // Moments int theta2 sigma_peak s^k ds (k = 0, 1, 2; s from the ray's origin, largest channel): the
+  // lateral variance of the light that reaches the camera from depth t is t^2 m0 - 2 t m1 + m2.
+  double m0 = 0.0, m1 = 0.0, m2 = 0.0;
   const double jitter = rng.uniform();
   MediumPoint mp;
   // Steps grow with the camera-side reduced depth: tau_step (1 + step_growth tau_red).
   march_growing(ctx_.majorants, o, d, std::numeric_limits<double>::infinity(), s_.tau_step, jitter,
         [&] { return 1.0 + s_.step_growth * max_component(tau_red); },
-        [&](const Vec3& p, double, double dt) {
+        [&](const Vec3& p, double t, double dt) {
           ctx_.media.eval(p, &mp);
           Rgb sigma_peak(0.0), sigma_theta(0.0);
           for (int i = 0; i < mp.count; ++i) {
@@ -243,7 +247,10 @@ Rgb MfsIntegrator::radiance(const Vec3& o, const Vec3& d, Rng& rng) const {
                             : moment(chi_w, l, 0.0) * std::exp(-tp[c] * (1.0 - moment(chi_p, l, 1.0)));
                   }
                 }
-                Li += (s_.light_side ? 1.0 : 1.0 - f) * grid_->scattered(p, -d, chi);
+                const double spread = std::sqrt(std::max(0.0, t * t * m0 - 2.0 * t * m1 + m2));
+                Li += (s_.light_side ? 1.0 : 1.0 - f) *
+                      (s_.filtered_lookups && !s_.light_side ? grid_->scattered_filtered(p, -d, chi, spread)
+                                                             : grid_->scattered(p, -d, chi));
               }
               in_scatter += mp.sigma_s_i[i] * Li;
               peak_scatter += mp.sigma_s_i[i] * Li_peak;
@@ -255,6 +262,12 @@ Rgb MfsIntegrator::radiance(const Vec3& o, const Vec3& d, Rng& rng) const {
           tau_p += sigma_peak * dt;
           theta_p += sigma_theta * dt;
           tau_red += sigma_red * dt;
+          {
+            const double a = max_component(sigma_theta) * dt, tm = t + (0.5 - jitter) * dt;  // step midpoint
+            m0 += a;
+            m1 += a * tm;
+            m2 += a * tm * tm;
+          }
           return max_component(s_.light_side ? T_full : T_red) > 1e-6;
         });
   // The environment behind the medium; its scattered light is in the grid. Camera side: its peak-scattered

@@ -24,6 +24,9 @@
 // (integrators/scatter_grid.h) and takes its last wide scatter at y:
 //     sigma_s (1 - f) (phi + 3 g_wide_eff(tau_p) F . w_o) / (4 pi)
 // with g_wide_eff = g_wide exp(-tau_p (1 - chi_1^peak)) (the camera-side peak blur of its mean cosine).
+// Option filtered_lookups reads that grid pre-filtered (mip-mapped) over the lateral spread of the
+// camera-side propagator, which grows with depth (seed sec. 1); the march's steps grow with the
+// camera-side reduced depth (step_growth).
 // Light transmittances come from deep shadow maps (deterministic). The environment (smooth in angle) is
 // carried by the scatter grid from its entry, so the camera ray needs no environment sampling.
 // Every channel uses its own optical depths; overlapping media share one tau_p (sum of f_i sigma_s_i).
@@ -43,6 +46,7 @@ namespace nimbus {
 struct MfsSettings {
   double tau_step = 0.1;           // optical depth per march step (against the majorant)
   double step_growth = 1.0;        // steps of tau_step (1 + step_growth tau_red), tau_red: camera-side
+  bool filtered_lookups = false;   // scatter grid looked up pre-filtered over the camera-side spread
   bool forward_light_path = true;  // light_path: "forward" (true) or "beer_lambert"
   bool gaussian = false;           // propagator: "gsa" (false) or "gaussian" (Gaussian stand-in for the peak)
   double peak_fraction = -1.0;     // f in [0, 0.99]; < 0: "auto" (g^2 per medium)

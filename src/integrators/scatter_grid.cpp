@@ -256,6 +256,81 @@ ScatterGrid::ScatterGrid(const SceneContext& ctx, const std::vector<const PhaseS
       values_[n * kFloatsPerNode + k] = float(sum * inv_volume);
     }
   });
+  build_mips();
+}
+
+void ScatterGrid::build_mips() {
+  // Each level halves the node count along every axis (nodes 2j of the level below), with the tent
+  // filter (1/4, 1/2, 1/4) per axis; nodes beyond the level below's last are clamped to it.
+  const int floats = 3 * coeffs_;
+  const float* src = values_.data();
+  std::array<int, 3> n = nodes_;
+  Vec3 h = spacing_;
+  while (std::max({n[0], n[1], n[2]}) > 4 && mips_.size() < 4) {
+    Level lv;
+    for (int a = 0; a < 3; ++a) {
+      lv.nodes[a] = std::max(2, (n[a] + 2) / 2);
+      lv.spacing[a] = 2.0 * h[a];
+    }
+    lv.values.assign(size_t(lv.nodes[0]) * lv.nodes[1] * lv.nodes[2] * floats, 0.0f);
+    const std::array<int, 3> nb = n;
+    auto at = [&](int x, int y, int z) {
+      x = std::clamp(x, 0, nb[0] - 1), y = std::clamp(y, 0, nb[1] - 1), z = std::clamp(z, 0, nb[2] - 1);
+      return src + ((size_t(z) * nb[1] + y) * nb[0] + x) * floats;
+    };
+    tbb::parallel_for(0, lv.nodes[2], [&](int z) {
+      for (int y = 0; y < lv.nodes[1]; ++y)
+        for (int x = 0; x < lv.nodes[0]; ++x) {
+          float* out = &lv.values[((size_t(z) * lv.nodes[1] + y) * lv.nodes[0] + x) * floats];
+          for (int dz = -1; dz <= 1; ++dz)
+            for (int dy = -1; dy <= 1; ++dy)
+              for (int dx = -1; dx <= 1; ++dx) {
+                const double w = (dx ? 0.25 : 0.5) * (dy ? 0.25 : 0.5) * (dz ? 0.25 : 0.5);
+                const float* in = at(2 * x + dx, 2 * y + dy, 2 * z + dz);
+                for (int k = 0; k < floats; ++k) out[k] += float(w * in[k]);
+              }
+        }
+    });
+    mips_.push_back(std::move(lv));
+    src = mips_.back().values.data();
+    n = mips_.back().nodes;
+    h = mips_.back().spacing;
+  }
+}
+
+void ScatterGrid::accumulate(int level, const Vec3& p, double wt, double* L) const {
+  const int floats = 3 * coeffs_;
+  const Level* lv = level > 0 ? &mips_[level - 1] : nullptr;
+  const TrilinearStencil st = trilinear_stencil(p, bounds_.lo, lv ? lv->spacing : spacing_, lv ? lv->nodes : nodes_);
+  const float* v = lv ? lv->values.data() : values_.data();
+  for (int k = 0; k < 8; ++k) {
+    const float* node = &v[st.node[k] * floats];
+    const double w = wt * st.weight[k];
+    for (int h = 0; h < floats; ++h) L[h] += w * node[h];
+  }
+}
+
+Rgb ScatterGrid::scattered_filtered(const Vec3& p, const Vec3& w_out, const std::array<Rgb, kShMaxBands>& chi,
+                                    double spread) const {
+  if (!bounds_.contains(p)) return Rgb(0.0);
+  const double h = std::min({spacing_.x, spacing_.y, spacing_.z});
+  const double level = std::clamp(std::log2(std::max(spread, 1e-300) / h), 0.0, double(mips_.size()));
+  if (!(level > 0.0)) return scattered(p, w_out, chi);
+  double L[3 * kShMaxBands * kShMaxBands] = {};
+  const int k0 = std::min(int(level), int(mips_.size()));
+  const double f = level - k0;
+  accumulate(k0, p, 1.0 - f, L);
+  if (f > 0.0) accumulate(k0 + 1, p, f, L);
+  double y[kShMaxBands * kShMaxBands];
+  sh_eval(w_out, bands_, y);
+  Rgb r;
+  for (int c = 0; c < 3; ++c) {
+    double v = 0.0;
+    for (int l = 0; l < bands_; ++l)
+      for (int hh = l * l; hh < (l + 1) * (l + 1); ++hh) v += chi[l][c] * L[coeffs_ * c + hh] * y[hh];
+    r[c] = std::max(0.0, v);
+  }
+  return r;
 }
 
 Rgb ScatterGrid::scattered(const Vec3& p, const Vec3& w_out, const std::array<Rgb, kShMaxBands>& chi) const {

@@ -53,9 +53,18 @@ class ScatterGrid {
   // outside the grid), clamped at zero: the radiance a unit of scattering with Legendre moments chi_l
   // (per channel; chi_0 = 1 for a normalised phase function) sends along w_out.
   Rgb scattered(const Vec3& p, const Vec3& w_out, const std::array<Rgb, kShMaxBands>& chi) const;
+  // The same from the pre-filtered (mip-mapped) grid, for light that reaches the camera from an area
+  // of lateral standard deviation `spread` (per component) around p: level log2(spread / spacing),
+  // blended between the two nearest levels (level k: 2^k spacings, a tent filter of the level below).
+  Rgb scattered_filtered(const Vec3& p, const Vec3& w_out, const std::array<Rgb, kShMaxBands>& chi,
+                         double spread) const;
   int bands() const { return bands_; }
 
-  size_t memory_bytes() const { return values_.size() * sizeof(float); }
+  size_t memory_bytes() const {
+    size_t bytes = values_.size() * sizeof(float);
+    for (const auto& m : mips_) bytes += m.values.size() * sizeof(float);
+    return bytes;
+  }
 
  private:
   Bounds bounds_;  // of the node grid (the media's bounds padded by one spacing)
@@ -63,6 +72,15 @@ class ScatterGrid {
   Vec3 spacing_{1.0};
   int bands_ = 3, coeffs_ = 9;
   std::vector<float> values_;  // per node: channel c at [coeffs c + h]: L_lm, h = l^2 + l + m
+  struct Level {
+    std::array<int, 3> nodes;
+    Vec3 spacing;
+    std::vector<float> values;
+  };
+  std::vector<Level> mips_;  // levels 1, 2, ...: nodes at bounds_.lo + j spacing (may overhang bounds_)
+  // The moments at p of level k (0: values_), summed into L with weight wt.
+  void accumulate(int level, const Vec3& p, double wt, double* L) const;
+  void build_mips();
 };
 
 class TransmittanceGrid;

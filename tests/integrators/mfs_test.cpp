@@ -173,6 +173,7 @@ TEST(Mfs, OptionsAreValidatedStrictly) {
   EXPECT_THROW(parse(R"({"beam_photons": 1e9})"), Error);
   EXPECT_NO_THROW(parse(R"({"light_blur": false})"));
   EXPECT_NO_THROW(parse(R"({"step_growth": 0})"));
+  EXPECT_NO_THROW(parse(R"({"filtered_lookups": true})"));
   EXPECT_THROW(parse(R"({"step_growth": -1})"), Error);
   EXPECT_THROW(parse(R"({"light_blur": "yes"})"), Error);
   EXPECT_THROW(parse(R"({"photon_transport": "fast"})"), Error);
@@ -414,6 +415,36 @@ TEST(Mfs, GrowingStepsMatchFixedSteps) {
   const Rgb a = image_mean(grown), b = image_mean(fixed);
   std::printf("growing steps %.5f, fixed steps %.5f\n", a[0], b[0]);
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(a[c], b[c], 0.01 * b[c]) << c;
+}
+
+// The scatter grid's pre-filtered (mip-mapped) lookups: a zero spread is the plain lookup, and the
+// image with the filtered lookups deeper in differs from the plain one by a few per cent at most (the
+// filter moves light within the medium, it does not make or lose much).
+TEST(Mfs, FilteredLookupsOfTheScatterGrid) {
+  Scene scene = test::scene_from_json("{" + test::camera_json(24, 24, 40.0) + R"(,
+    "media": [{"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1}, "sigma_s": 8.0, "sigma_a": 0.05,
+               "phase": {"type": "hg", "g": 0.8}}],
+    "lights": [{"type": "directional", "direction": [-1, 0.3, 0.2], "irradiance": 1.0}]})");
+  const SceneContext ctx(scene);
+  const MfsIntegrator mfs(ctx, parse_mfs_settings(nlohmann::json::object(), "test", true));
+  ASSERT_NE(mfs.scatter_grid(), nullptr);
+  std::array<Rgb, kShMaxBands> chi;
+  for (int l = 0; l < kShMaxBands; ++l) chi[l] = Rgb(std::pow(0.5, l));
+  Rng rng(5, 0);
+  for (int i = 0; i < 100; ++i) {
+    const Vec3 p(1.6 * rng.uniform() - 0.8, 1.6 * rng.uniform() - 0.8, 1.6 * rng.uniform() - 0.8);
+    const Vec3 w = normalize(Vec3(rng.uniform() - 0.5, rng.uniform() - 0.5, rng.uniform() - 0.5));
+    const Rgb a = mfs.scatter_grid()->scattered(p, w, chi), b = mfs.scatter_grid()->scattered_filtered(p, w, chi, 0.0);
+    for (int c = 0; c < 3; ++c) EXPECT_EQ(a[c], b[c]);
+  }
+  scene.integrator.type = "mfs";
+  scene.integrator.spp = 4;
+  const Rgb plain = image_mean(render(scene, RenderOptions{}).image);
+  scene.integrator.options = {{"filtered_lookups", true}};
+  const Rgb filtered = image_mean(render(scene, RenderOptions{}).image);
+  std::printf("filtered lookups %.5f, plain %.5f\n", filtered[0], plain[0]);
+  EXPECT_NEAR(filtered[0], plain[0], 0.04 * plain[0]);
+  EXPECT_NE(filtered[0], plain[0]);
 }
 
 // A point light (inside the media's bounding sphere, so photons leave it in every direction) and
