@@ -146,6 +146,21 @@ std::string grid_list(const openvdb::GridPtrVec& grids) {
 
 }  // namespace
 
+// The root table's keys (origins of 4096^3 nodes and tiles) of a grid of any standard type must lie
+// within +-2^30: OpenVDB's bbox evaluation and NanoVDB's converter add node sizes to them in int32, so a
+// corrupt key near INT_MAX would overflow.
+void check_index_range(const std::filesystem::path& path, const openvdb::GridBase& grid) {
+  grid.apply<openvdb::GridTypes>([&](const auto& typed) {
+    for (auto it = typed.tree().root().cbeginChildAll(); it; ++it) {
+      const openvdb::Coord o = it.getCoord();
+      for (int a = 0; a < 3; ++a)
+        if (o[a] < -kMaxIndexCoord || o[a] > kMaxIndexCoord - 4096)
+          fail(path, fmt::format("grid {} has voxels at index ({}, {}, {}), beyond +-2^30",
+                                 display_name(grid.getName()), o[0], o[1], o[2]));
+    }
+  });
+}
+
 NanoHandle load_openvdb_float_grid(const std::filesystem::path& path, const std::string& grid_name) {
   return with_grids(path, [&](const openvdb::GridPtrVec& grids) {
     openvdb::GridBase::ConstPtr chosen;
@@ -169,15 +184,7 @@ NanoHandle load_openvdb_float_grid(const std::filesystem::path& path, const std:
                              display_name(grid->getName())));
     if (grid->tree().activeVoxelCount() == 0)
       fail(path, fmt::format("grid {} is empty: no active voxels", display_name(grid->getName())));
-    // The root table's keys (origins of 4096^3 nodes and tiles): NanoVDB's converter adds node sizes to
-    // them in int32, so a corrupt key near INT_MAX would overflow.
-    for (auto it = grid->tree().root().cbeginChildAll(); it; ++it) {
-      const openvdb::Coord o = it.getCoord();
-      for (int a = 0; a < 3; ++a)
-        if (o[a] < -kMaxIndexCoord || o[a] > kMaxIndexCoord - 4096)
-          fail(path, fmt::format("grid {} has voxels at index ({}, {}, {}), beyond +-2^30",
-                                 display_name(grid->getName()), o[0], o[1], o[2]));
-    }
+    check_index_range(path, *grid);
     // No stats or checksum: DensityGrid computes what it needs from the converted tree.
     return nanovdb::openToNanoVDB<nanovdb::HostBuffer>(*grid, nanovdb::StatsMode::BBox,
                                                        nanovdb::ChecksumMode::Disable);
@@ -194,6 +201,7 @@ std::vector<GridInfo> inspect_openvdb_file(const std::filesystem::path& path) {
       gi.grid_class = openvdb::GridBase::gridClassToString(g->getGridClass());
       gi.active_voxels = g->activeVoxelCount();
       gi.tiles = g->baseTree().activeTileCount();
+      check_index_range(path, *g);
       const openvdb::CoordBBox bb = g->evalActiveVoxelBoundingBox();
       gi.empty = bb.empty();
       const auto vs = g->voxelSize();
