@@ -202,6 +202,17 @@ ORDER_SCENES = ["sphere_r2_a0.99_hg0.85_side", "sphere_r10_a0.99_hg0.85_side", "
                 "sphere_r10_a0.99_hg0.85_back", "sphere_r20_a0.9999_hg0.95_back", "disney_cloud"]
 
 
+def write_between_markers(name, text):
+    """Replaces what lies between <!-- name --> and <!-- /name --> in docs/validation/render.md."""
+    doc = os.path.join(DOCS, "render.md")
+    if not os.path.exists(doc):
+        return
+    d = open(doc).read()
+    a, b = d.find(f"<!-- {name} -->"), d.find(f"<!-- /{name} -->")
+    if a >= 0 and b > a:
+        open(doc, "w").write(d[:a] + f"<!-- {name} -->\n" + text + "\n" + d[b:])
+
+
 def orders():
     """mfs with K wide scatters against the path tracer limited to K wide scatters (the same split)."""
     path = os.path.join(DOCS, "render_orders.json")
@@ -231,12 +242,7 @@ def orders():
             for K in range(4)) + " |")
     text = "\n".join(lines)
     print(text)
-    doc = os.path.join(DOCS, "render.md")
-    if os.path.exists(doc):
-        d = open(doc).read()
-        a, b = d.find("<!-- orders -->"), d.find("<!-- /orders -->")
-        if a >= 0 and b > a:
-            open(doc, "w").write(d[:a] + "<!-- orders -->\n" + text + "\n" + d[b:])
+    write_between_markers("orders", text)
 
 
 def size_study():
@@ -288,11 +294,7 @@ def size_table():
     for label, c in rows["configs"].items():
         lines.append(f"| {label} | {c['time_s']:.1f} | {c['mean_error']:+.1%} | {c['rel_rmse']:.1%} | "
                      f"{c['pathtrace_spp']:.0f} | {c['pathtrace_time_s']:.1f} | {c['speedup']:.1f}x |")
-    doc = os.path.join(DOCS, "render.md")
-    d = open(doc).read()
-    a, b = d.find("<!-- size -->"), d.find("<!-- /size -->")
-    if a >= 0 and b > a:
-        open(doc, "w").write(d[:a] + "<!-- size -->\n" + "\n".join(lines) + "\n" + d[b:])
+    write_between_markers("size", "\n".join(lines))
 
 
 def write_table(results):
@@ -317,13 +319,7 @@ def write_table(results):
             f"{cs[l]['mean_error']:+.0%} / {cs[l]['rel_rmse']:.0%}" if l in cs else "-" for l, _, _ in CONFIGS) + " |")
     text = "\n".join(lines)
     print(text)
-    # Between the markers of docs/validation/render.md.
-    doc = os.path.join(DOCS, "render.md")
-    if os.path.exists(doc):
-        d = open(doc).read()
-        a, b = d.find("<!-- table -->"), d.find("<!-- /table -->")
-        if a >= 0 and b > a:
-            open(doc, "w").write(d[:a] + "<!-- table -->\n" + text + "\n" + d[b:])
+    write_between_markers("table", text)
 
 
 def plots(results):

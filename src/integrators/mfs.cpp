@@ -99,15 +99,13 @@ MfsIntegrator::MfsIntegrator(const SceneContext& context, MfsSettings settings)
     const double across = cells > 0 ? std::max({e.x, e.y, e.z}) * sum / double(cells) : 0.0;
     s_.grid.resolution = std::isfinite(across) ? int(std::clamp(std::ceil(across / 1.6), 32.0, 64.0)) : 64;
   }
+  std::vector<const PhaseSplit*> splits;  // for the photon grids
+  for (const auto& sp : splits_) splits.push_back(sp.get());
   if (s_.forward_light_path && s_.beam_photons > 0 && !ctx_.lights.empty()) {
-    std::vector<const PhaseSplit*> splits;
-    for (const auto& sp : splits_) splits.push_back(sp.get());
     beam_ = std::make_unique<BeamGrid>(ctx_, splits, f_, reduced_maps_, s_.beam_photons, s_.grid.resolution,
                                        s_.grid.seed);
   }
   if (s_.large_angle_scatters != 0 && (s_.large_angle_scatters != 1 || ctx_.has_environment)) {
-    std::vector<const PhaseSplit*> splits;
-    for (const auto& sp : splits_) splits.push_back(sp.get());
     grid_ = std::make_unique<ScatterGrid>(ctx_, splits, f_, s_.grid);
   }
 }

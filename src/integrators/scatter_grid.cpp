@@ -310,38 +310,7 @@ void ScatterGrid::accumulate(int level, const Vec3& p, double wt, double* L) con
   }
 }
 
-Rgb ScatterGrid::scattered_filtered(const Vec3& p, const Vec3& w_out, const std::array<Rgb, kShMaxBands>& chi,
-                                    double spread) const {
-  if (!bounds_.contains(p)) return Rgb(0.0);
-  const double h = std::min({spacing_.x, spacing_.y, spacing_.z});
-  const double level = std::clamp(std::log2(std::max(spread, 1e-300) / h), 0.0, double(mips_.size()));
-  if (!(level > 0.0)) return scattered(p, w_out, chi);
-  double L[3 * kShMaxBands * kShMaxBands] = {};
-  const int k0 = std::min(int(level), int(mips_.size()));
-  const double f = level - k0;
-  accumulate(k0, p, 1.0 - f, L);
-  if (f > 0.0) accumulate(k0 + 1, p, f, L);
-  double y[kShMaxBands * kShMaxBands];
-  sh_eval(w_out, bands_, y);
-  Rgb r;
-  for (int c = 0; c < 3; ++c) {
-    double v = 0.0;
-    for (int l = 0; l < bands_; ++l)
-      for (int hh = l * l; hh < (l + 1) * (l + 1); ++hh) v += chi[l][c] * L[coeffs_ * c + hh] * y[hh];
-    r[c] = std::max(0.0, v);
-  }
-  return r;
-}
-
-Rgb ScatterGrid::scattered(const Vec3& p, const Vec3& w_out, const std::array<Rgb, kShMaxBands>& chi) const {
-  if (!bounds_.contains(p)) return Rgb(0.0);
-  const int floats = 3 * coeffs_;
-  double L[3 * kShMaxBands * kShMaxBands] = {};
-  const TrilinearStencil st = trilinear_stencil(p, bounds_.lo, spacing_, nodes_);
-  for (int k = 0; k < 8; ++k) {
-    const float* node = &values_[st.node[k] * floats];
-    for (int h = 0; h < floats; ++h) L[h] += st.weight[k] * node[h];
-  }
+Rgb ScatterGrid::evaluate(const double* L, const Vec3& w_out, const std::array<Rgb, kShMaxBands>& chi) const {
   double y[kShMaxBands * kShMaxBands];
   sh_eval(w_out, bands_, y);
   Rgb r;
@@ -354,9 +323,26 @@ Rgb ScatterGrid::scattered(const Vec3& p, const Vec3& w_out, const std::array<Rg
   return r;
 }
 
-}  // namespace nimbus
+Rgb ScatterGrid::scattered_filtered(const Vec3& p, const Vec3& w_out, const std::array<Rgb, kShMaxBands>& chi,
+                                    double spread) const {
+  if (!bounds_.contains(p)) return Rgb(0.0);
+  const double h = std::min({spacing_.x, spacing_.y, spacing_.z});
+  const double level = std::clamp(std::log2(std::max(spread, 1e-300) / h), 0.0, double(mips_.size()));
+  if (!(level > 0.0)) return scattered(p, w_out, chi);
+  double L[3 * kShMaxBands * kShMaxBands] = {};
+  const int k0 = std::min(int(level), int(mips_.size()));
+  const double f = level - k0;
+  accumulate(k0, p, 1.0 - f, L);
+  if (f > 0.0) accumulate(k0 + 1, p, f, L);
+  return evaluate(L, w_out, chi);
+}
 
-namespace nimbus {
+Rgb ScatterGrid::scattered(const Vec3& p, const Vec3& w_out, const std::array<Rgb, kShMaxBands>& chi) const {
+  if (!bounds_.contains(p)) return Rgb(0.0);
+  double L[3 * kShMaxBands * kShMaxBands] = {};
+  accumulate(0, p, 1.0, L);
+  return evaluate(L, w_out, chi);
+}
 
 BeamGrid::BeamGrid(const SceneContext& ctx, const std::vector<const PhaseSplit*>& splits,
                    const std::vector<double>& peak_fraction, const std::vector<TransmittanceGrid>& reduced_maps,

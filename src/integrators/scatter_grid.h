@@ -80,6 +80,8 @@ class ScatterGrid {
   std::vector<Level> mips_;  // levels 1, 2, ...: nodes at bounds_.lo + j spacing (may overhang bounds_)
   // The moments at p of level k (0: values_), summed into L with weight wt.
   void accumulate(int level, const Vec3& p, double wt, double* L) const;
+  // sum_lm chi_l L_lm Y_lm(w_out) per channel from moments L (as values_ lays out a node), clamped at 0.
+  Rgb evaluate(const double* L, const Vec3& w_out, const std::array<Rgb, kShMaxBands>& chi) const;
   void build_mips();
 };
 
