@@ -6,7 +6,7 @@
 
 #include <filesystem>
 
-#include "integrators/integrator.h"
+#include "integrators/registry.h"
 #include "integrators/mfs.h"
 #include "nimbus/render.h"
 #include "nimbus/scene.h"
@@ -81,7 +81,7 @@ void BM_MfsCloudMemory(benchmark::State& state) {
   size_t grid_bytes = 0, beam_bytes = 0, total_bytes = 0;
   for (auto _ : state) {
     const nimbus::MfsIntegrator mfs(ctx,
-                                    nimbus::parse_mfs_settings(scene.integrator.options, "bench", false));
+                                    nimbus::mfs_settings_from_json(scene.integrator.options, "bench"));
     grid_bytes = mfs.scatter_grid()->memory_bytes();
     beam_bytes = mfs.beam_grid() ? mfs.beam_grid()->memory_bytes() : 0;
     total_bytes = mfs.memory_bytes();

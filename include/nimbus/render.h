@@ -15,7 +15,9 @@ namespace nimbus {
 struct RenderOptions {
   std::optional<int> spp;               // overrides the scene's integrator.spp
   std::optional<uint64_t> seed;         // overrides integrator.seed
-  std::optional<std::string> integrator;  // overrides integrator.type
+  // Overrides integrator.type; another integrator than the scene's starts from its own defaults (the
+  // scene's integrator fields belong to the integrator it names).
+  std::optional<std::string> integrator;
   int threads = 0;                      // 0 = all hardware threads
   int tile_size = 16;
   // Called from worker threads as tiles finish: (tiles done, tiles total, samples so far).
@@ -33,6 +35,9 @@ struct RenderResult {
   std::string integrator;
   int spp = 0;
   uint64_t seed = 0;
+  // The integrator block as rendered: type, spp, seed, max_events and the integrator's own fields with
+  // "auto" choices resolved (also in the EXR header as nimbus/integrator_settings).
+  nlohmann::json settings;
   ImageMetadata metadata;  // scene and settings, for the EXR header
 };
 

@@ -11,8 +11,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "core/math.h"
-#include "media/phase.h"
+#include "nimbus/phase.h"
+#include "nimbus/types.h"
 
 namespace nimbus {
 
@@ -83,7 +83,9 @@ struct IntegratorSettings {
   int spp = 64;
   int max_events = 0;  // most scattering events on a path; 0 = unlimited
   uint64_t seed = 1;
-  nlohmann::json options = nlohmann::json::object();  // integrator-specific fields
+  // The integrator's own fields as written (checked by the scene parser through the registry; each
+  // integrator's header lists them).
+  nlohmann::json options = nlohmann::json::object();
 };
 
 struct Scene {

@@ -1,16 +1,14 @@
 // Small vector math on top of Imath (V3d is the position/direction type, Rgb the colour type).
 #pragma once
 
-#include <Imath/ImathVec.h>
-
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
-namespace nimbus {
+#include "nimbus/types.h"
 
-using Vec3 = Imath::V3d;
-using Rgb = Imath::V3d;  // linear RGB radiance or per-channel coefficients
+namespace nimbus {
 
 inline constexpr double kPi = std::numbers::pi;
 inline constexpr double kInvPi = 1.0 / std::numbers::pi;

@@ -3,74 +3,79 @@
 #include <fmt/format.h>
 
 #include "integrators/tracking.h"
-#include "io/json_reader.h"
+#include "core/json_reader.h"
 #include "nimbus/error.h"
 
 namespace nimbus {
 
-MfsSettings parse_mfs_settings(const nlohmann::json& options, const std::string& where, bool strict,
-                               uint64_t seed) {
+namespace {
+const std::vector<std::string> kLightPathNames = {"forward", "beer_lambert"};
+const std::vector<std::string> kPropagatorNames = {"gsa", "gaussian"};
+const std::vector<std::string> kPhotonTransportNames = {"exact", "similarity"};
+const std::vector<std::string> kForwardSideNames = {"camera", "light"};
+}  // namespace
+
+MfsSettings mfs_settings_from_json(const nlohmann::json& options, const std::string& where) {
   MfsSettings s;
-  s.grid.seed = seed;
   JsonObject o(options, where, "/integrator");
   s.tau_step = o.number("tau_step", 1e-4, 100.0, s.tau_step);
-  const std::string light_path = o.string("light_path", "forward");
-  if (light_path != "forward" && light_path != "beer_lambert")
-    o.fail("light_path", "must be \"forward\" or \"beer_lambert\"");
-  s.forward_light_path = light_path == "forward";
-  const std::string propagator = o.string("propagator", "gsa");
-  if (propagator != "gsa" && propagator != "gaussian")
-    o.fail("propagator", "must be \"gsa\" or \"gaussian\"");
-  s.gaussian = propagator == "gaussian";
-  if (o.has("peak_fraction") && o.raw("peak_fraction").is_string()) {
-    if (o.string("peak_fraction") != "auto")
-      o.fail("peak_fraction", "must be \"auto\" or a number in [0, 0.99]");
-  } else {
-    s.peak_fraction = o.number("peak_fraction", 0.0, 0.99, s.peak_fraction < 0 ? -1.0 : s.peak_fraction);
-  }
-  if (o.has("large_angle_scatters") && o.raw("large_angle_scatters").is_string()) {
-    if (o.string("large_angle_scatters") != "all")
-      o.fail("large_angle_scatters", "must be \"all\" or an integer in [0, 1024]");
-  } else {
-    s.large_angle_scatters = int(o.integer("large_angle_scatters", 0, 1024, -1));
-  }
-  s.grid.max_wide_scatters = std::max(0, s.large_angle_scatters);
-  s.grid.photons = int(o.integer("photons", 1, 1 << 26, s.grid.photons));
-  if (o.has("scatter_grid_resolution") && o.raw("scatter_grid_resolution").is_string()) {
-    if (o.string("scatter_grid_resolution") != "auto")
-      o.fail("scatter_grid_resolution", "must be \"auto\" or an integer in [4, 96]");
-    s.grid.resolution = 0;
-  } else {
-    s.grid.resolution = int(o.integer("scatter_grid_resolution", 4, 96, s.grid.resolution));
-  }
-  s.grid.bands = int(o.integer("scatter_grid_bands", 1, kShMaxBands, s.grid.bands));
-  const std::string transport = o.string("photon_transport", "exact");
-  if (transport != "similarity" && transport != "exact")
-    o.fail("photon_transport", "must be \"similarity\" or \"exact\"");
-  s.grid.exact_transport = transport == "exact";
-  const std::string side = o.string("forward_side", "camera");
-  if (side != "camera" && side != "light") o.fail("forward_side", "must be \"camera\" or \"light\"");
-  s.light_side = side == "light";
-  s.path_lengthening = o.boolean("path_lengthening", s.path_lengthening);
+  s.step_growth = o.number("step_growth", 0.0, 100.0, s.step_growth);
+  s.light_path = LightPath(o.choice("light_path", kLightPathNames, int(s.light_path)));
+  s.propagator = Propagator(o.choice("propagator", kPropagatorNames, int(s.propagator)));
+  if (double f = 0.0; o.keyword_or_number("peak_fraction", "auto", 0.0, 0.99, &f)) s.peak_fraction = f;
+  if (int64_t k = 0; o.keyword_or_integer("large_angle_scatters", "all", 0, 1024, &k)) s.large_angle_scatters = int(k);
+  s.photons = int(o.integer("photons", 1, 1 << 26, s.photons));
+  s.photon_transport =
+      PhotonTransport(o.choice("photon_transport", kPhotonTransportNames, int(s.photon_transport)));
+  if (int64_t n = 0; o.keyword_or_integer("scatter_grid_resolution", "auto", 4, 96, &n))
+    s.scatter_grid_resolution = int(n);
+  s.scatter_grid_bands = int(o.integer("scatter_grid_bands", 1, kShMaxBands, s.scatter_grid_bands));
+  s.forward_side = ForwardSide(o.choice("forward_side", kForwardSideNames, int(s.forward_side)));
   s.beam_photons = int(o.integer("beam_photons", 0, 1 << 24, s.beam_photons));
   s.light_blur = o.boolean("light_blur", s.light_blur);
-  s.step_growth = o.number("step_growth", 0.0, 100.0, s.step_growth);
+  s.path_lengthening = o.boolean("path_lengthening", s.path_lengthening);
   s.filtered_lookups = o.boolean("filtered_lookups", s.filtered_lookups);
-  if (s.light_side) {
-    s.forward_light_path = true;
-    s.grid.exact_transport = true;
-  }
   s.shadow_map_resolution = int(o.integer("shadow_map_resolution", 8, 1024, s.shadow_map_resolution));
-  if (strict) o.finish();
+  o.finish();
+  // The light side carries the light to every scatter through peak scatters, with photons in the true
+  // medium: other choices would be silently overridden, so they are errors.
+  if (s.light_side() && !s.forward_light_path())
+    o.fail("light_path", "\"beer_lambert\" conflicts with " + o.path_of("forward_side") +
+                             " \"light\" (the light side needs \"forward\")");
+  if (s.light_side() && s.photon_transport != PhotonTransport::exact)
+    o.fail("photon_transport", "\"similarity\" conflicts with " + o.path_of("forward_side") +
+                                   " \"light\" (the light side needs \"exact\")");
   return s;
 }
 
-MfsIntegrator::MfsIntegrator(const SceneContext& context, MfsSettings settings)
+nlohmann::json to_json(const MfsSettings& s) {
+  nlohmann::json j = {{"tau_step", s.tau_step},
+                      {"step_growth", s.step_growth},
+                      {"light_path", kLightPathNames[int(s.light_path)]},
+                      {"propagator", kPropagatorNames[int(s.propagator)]},
+                      {"photons", s.photons},
+                      {"photon_transport", kPhotonTransportNames[int(s.photon_transport)]},
+                      {"scatter_grid_bands", s.scatter_grid_bands},
+                      {"forward_side", kForwardSideNames[int(s.forward_side)]},
+                      {"beam_photons", s.beam_photons},
+                      {"light_blur", s.light_blur},
+                      {"path_lengthening", s.path_lengthening},
+                      {"filtered_lookups", s.filtered_lookups},
+                      {"shadow_map_resolution", s.shadow_map_resolution}};
+  j["peak_fraction"] = s.peak_fraction ? nlohmann::json(*s.peak_fraction) : nlohmann::json("auto");
+  j["large_angle_scatters"] =
+      s.large_angle_scatters ? nlohmann::json(*s.large_angle_scatters) : nlohmann::json("all");
+  j["scatter_grid_resolution"] =
+      s.scatter_grid_resolution ? nlohmann::json(*s.scatter_grid_resolution) : nlohmann::json("auto");
+  return j;
+}
+
+MfsIntegrator::MfsIntegrator(const SceneContext& context, MfsSettings settings, uint64_t seed)
     : ctx_(context), s_(settings) {
   for (int i = 0; i < ctx_.media.count(); ++i) {
     const Phase& phase = ctx_.media.phase(i);
-    const double f = s_.peak_fraction < 0.0 ? std::min(0.99, auto_peak_fraction(phase)) : s_.peak_fraction;
-    splits_.push_back(std::make_unique<PhaseSplit>(phase, f, s_.gaussian));
+    const double f = s_.peak_fraction ? *s_.peak_fraction : std::min(0.99, auto_peak_fraction(phase));
+    splits_.push_back(std::make_unique<PhaseSplit>(phase, f, s_.propagator == Propagator::gaussian));
     f_.push_back(splits_.back()->f());
     theta2_.push_back(splits_.back()->theta2());
   }
@@ -80,10 +85,10 @@ MfsIntegrator::MfsIntegrator(const SceneContext& context, MfsSettings settings)
   constexpr double map_step = 0.25;
   for (const Light& l : ctx_.lights) {
     full_maps_.emplace_back(ctx_.media, ctx_.majorants, l, s_.shadow_map_resolution, map_step);
-    if (s_.forward_light_path)
+    if (s_.forward_light_path())
       reduced_maps_.emplace_back(ctx_.media, ctx_.majorants, l, s_.shadow_map_resolution, map_step, f_);
   }
-  if (s_.grid.resolution <= 0) {
+  if (!s_.scatter_grid_resolution) {
     // "auto": cells of at most ~1.6 optical depths at the medium's typical extinction (the mean of the
     // majorant grid's non-empty cells), 32 to 64 nodes along the longest axis: 32 up to an optical size
     // of ~50 across. (A uniform medium's whole extinction; a cloud's dense core counts less.)
@@ -97,16 +102,25 @@ MfsIntegrator::MfsIntegrator(const SceneContext& context, MfsSettings settings)
           if (const double m = ctx_.majorants.cell_majorant(x, y, z); m > 0.0) sum += m, ++cells;
     const Vec3 e = b.empty() ? Vec3(0.0) : b.hi - b.lo;
     const double across = cells > 0 ? std::max({e.x, e.y, e.z}) * sum / double(cells) : 0.0;
-    s_.grid.resolution = std::isfinite(across) ? int(std::clamp(std::ceil(across / 1.6), 32.0, 64.0)) : 64;
+    s_.scatter_grid_resolution =
+        std::isfinite(across) ? int(std::clamp(std::ceil(across / 1.6), 32.0, 64.0)) : 64;
   }
   std::vector<const PhaseSplit*> splits;  // for the photon grids
   for (const auto& sp : splits_) splits.push_back(sp.get());
-  if (s_.forward_light_path && s_.beam_photons > 0 && !ctx_.lights.empty()) {
-    beam_ = std::make_unique<BeamGrid>(ctx_, splits, f_, reduced_maps_, s_.beam_photons, s_.grid.resolution,
-                                       s_.grid.seed);
+  if (s_.forward_light_path() && s_.beam_photons > 0 && !ctx_.lights.empty()) {
+    beam_ = std::make_unique<BeamGrid>(ctx_, splits, f_, reduced_maps_, s_.beam_photons,
+                                       *s_.scatter_grid_resolution, seed);
   }
+  // Wide scatters 2 .. K from the scatter grid (for K = 1 only the environment's light).
   if (s_.large_angle_scatters != 0 && (s_.large_angle_scatters != 1 || ctx_.has_environment)) {
-    grid_ = std::make_unique<ScatterGrid>(ctx_, splits, f_, s_.grid);
+    ScatterGridSettings grid;
+    grid.photons = s_.photons;
+    grid.resolution = *s_.scatter_grid_resolution;
+    grid.max_wide_scatters = s_.large_angle_scatters.value_or(0);
+    grid.exact_transport = s_.photon_transport == PhotonTransport::exact;
+    grid.bands = s_.scatter_grid_bands;
+    grid.seed = seed;
+    grid_ = std::make_unique<ScatterGrid>(ctx_, splits, f_, grid);
   }
 }
 
@@ -115,10 +129,6 @@ size_t MfsIntegrator::memory_bytes() const {
   for (const auto& m : full_maps_) bytes += m.memory_bytes();
   for (const auto& m : reduced_maps_) bytes += m.memory_bytes();
   return bytes;
-}
-
-Rgb MfsIntegrator::sample(double px, double py, Rng& rng) const {
-  return radiance(ctx_.camera.origin(), ctx_.camera.direction(px, py), rng);
 }
 
 namespace {
@@ -157,9 +167,9 @@ Rgb MfsIntegrator::radiance(const Vec3& o, const Vec3& d, Rng& rng) const {
           const Rgb sigma_red = mp.sigma_t() - sigma_peak;
           if (max_component(mp.sigma_s) > 0.0) {
             // Camera-side depths at the sample point.
-            Rgb T_here = s_.light_side ? T_full * exp(-mp.sigma_t() * (jitter * dt))
+            Rgb T_here = s_.light_side() ? T_full * exp(-mp.sigma_t() * (jitter * dt))
                                        : T_red * exp(-sigma_red * (jitter * dt));
-            if (!s_.light_side && s_.path_lengthening)
+            if (!s_.light_side() && s_.path_lengthening)
               for (int c = 0; c < 3; ++c)
                 T_here[c] *= lengthening(theta_p[c] + sigma_theta[c] * jitter * dt,
                                          tau_red[c] + sigma_red[c] * jitter * dt);
@@ -177,7 +187,7 @@ Rgb MfsIntegrator::radiance(const Vec3& o, const Vec3& d, Rng& rng) const {
                 if (!sample_light(ctx_.lights[l], p, u1, u2, &ls)) continue;
                 const double mu = dot(d, ls.wi);
                 const Rgb T_light = full_maps_[l].lookup(p);
-                Rgb T_wide = s_.forward_light_path ? reduced_maps_[l].lookup(p) : T_light;
+                Rgb T_wide = s_.forward_light_path() ? reduced_maps_[l].lookup(p) : T_light;
                 // Light-side peak depth ln(T_wide / T_light) and its path lengthening: from the
                 // photon-traced beam where there is one (its loss factor, and the peak depth whose
                 // spread has the beam's mean cosine), else the straight-line picture and, optionally,
@@ -195,10 +205,10 @@ Rgb MfsIntegrator::radiance(const Vec3& o, const Vec3& d, Rng& rng) const {
                   }
                   tps[c] = T_light[c] > 1e-30 ? std::max(0.0, std::log(T_wide[c] / T_light[c]))
                                               : PhaseSplit::kTauMax;
-                  if (s_.forward_light_path && s_.path_lengthening && T_wide[c] > 0.0)
+                  if (s_.forward_light_path() && s_.path_lengthening && T_wide[c] > 0.0)
                     T_wide[c] *= lengthening(theta2_[i] * tps[c], -std::log(T_wide[c]));
                 }
-                if (s_.light_side) {
+                if (s_.light_side()) {
                   // The light's peak-only (zero wide scatter) beam at p: total T_wide, spread by the
                   // light-side peak depth ln(T_wide / T_light); scattered by the whole phase function.
                   for (int c = 0; c < 3; ++c) {
@@ -214,7 +224,7 @@ Rgb MfsIntegrator::radiance(const Vec3& o, const Vec3& d, Rng& rng) const {
                   if (s_.large_angle_scatters != 0)
                     Li[c] += ls.weight[c] * (1.0 - f) * split.wide_eff(tp[c] + (s_.light_blur ? tps[c] : 0.0), mu) *
                              T_wide[c];
-                  if (s_.forward_light_path) {
+                  if (s_.forward_light_path()) {
                     // Paths without a wide scatter, counted at their last peak scatter (here): the light's
                     // forward-scattered beam (total T_wide, spread by the light-side peak depth
                     // ln(T_wide / T_light)), then straight to the camera (plain transmittance).
@@ -238,7 +248,7 @@ Rgb MfsIntegrator::radiance(const Vec3& o, const Vec3& d, Rng& rng) const {
                 for (int l = 0; l < grid_->bands(); ++l) {
                   for (int c = 0; c < 3; ++c) {
                     chi[l][c] =
-                        s_.light_side
+                        s_.light_side()
                             // Every scatter at p (whole phase function); the camera leg is exact.
                             ? f * moment(chi_p, l, 1.0) + (1.0 - f) * moment(chi_w, l, 0.0)
                             // The wide part's moments after the camera-side peak blur.
@@ -246,8 +256,8 @@ Rgb MfsIntegrator::radiance(const Vec3& o, const Vec3& d, Rng& rng) const {
                   }
                 }
                 const double spread = std::sqrt(std::max(0.0, t * t * m0 - 2.0 * t * m1 + m2));
-                Li += (s_.light_side ? 1.0 : 1.0 - f) *
-                      (s_.filtered_lookups && !s_.light_side ? grid_->scattered_filtered(p, -d, chi, spread)
+                Li += (s_.light_side() ? 1.0 : 1.0 - f) *
+                      (s_.filtered_lookups && !s_.light_side() ? grid_->scattered_filtered(p, -d, chi, spread)
                                                              : grid_->scattered(p, -d, chi));
               }
               in_scatter += mp.sigma_s_i[i] * Li;
@@ -266,11 +276,11 @@ Rgb MfsIntegrator::radiance(const Vec3& o, const Vec3& d, Rng& rng) const {
             m1 += a * tm;
             m2 += a * tm * tm;
           }
-          return max_component(s_.light_side ? T_full : T_red) > 1e-6;
+          return max_component(s_.light_side() ? T_full : T_red) > 1e-6;
         });
   // The environment behind the medium; its scattered light is in the grid. Camera side: its peak-scattered
   // light stays on the ray (smooth in angle), so it is attenuated by the reduced extinction only.
-  if (ctx_.has_environment) L += (s_.light_side ? T_full : T_red) * ctx_.environment;
+  if (ctx_.has_environment) L += (s_.light_side() ? T_full : T_red) * ctx_.environment;
   return L;
 }
 

@@ -30,42 +30,85 @@
 // Light transmittances come from deep shadow maps (deterministic). The environment (smooth in angle) is
 // carried by the scatter grid from its entry, so the camera ray needs no environment sampling.
 // Every channel uses its own optical depths; overlapping media share one tau_p (sum of f_i sigma_s_i).
+//
+// Options (the JSON fields of the scene's integrator block besides type, spp, seed, max_events; the
+// settings struct's fields carry the same names; docs/scene-format.md says more):
+//
+// | field                     | type                          | default   | meaning                               |
+// |---------------------------|-------------------------------|-----------|---------------------------------------|
+// | `tau_step`                | number in [1e-4, 100]         | 0.1       | optical depth per march step (against the majorant) |
+// | `step_growth`             | number in [0, 100]            | 1         | steps of tau_step (1 + step_growth tau_red), tau_red the camera-side reduced depth |
+// | `light_path`              | "forward" or "beer_lambert"   | "forward" | the light reaches the first wide scatter through peak scatters (reduced extinction), or unscattered only (the seed paper) |
+// | `propagator`              | "gsa" or "gaussian"           | "gsa"     | the peak's own moments in the small-angle propagator, or a Gaussian stand-in with the same theta2 |
+// | `peak_fraction`           | "auto" or [0, 0.99]           | "auto"    | f, the part of each phase function carried as a forward peak ("auto": g^2 per medium) |
+// | `large_angle_scatters`    | "all" or integer in [0, 1024] | "all"     | K, at most K wide scatters per path (0: the peak only; 1: the seed's picture) |
+// | `photons`                 | integer in [1, 2^26]          | 262144    | scatter grid photons per channel pass, shared among the lights |
+// | `photon_transport`        | "exact" or "similarity"       | "exact"   | scatter grid photons in the true medium, or in the delta-scaled one |
+// | `scatter_grid_resolution` | "auto" or integer in [4, 96]  | "auto"    | scatter and beam grid nodes along the longest axis ("auto": ~1.6 optical depths per cell, 32 to 64; the header of a rendered image holds the number chosen) |
+// | `scatter_grid_bands`      | integer in [1, 3]             | 3         | spherical-harmonic bands used at lookup (l < bands) |
+// | `forward_side`            | "camera" or "light"           | "camera"  | peak scatters after the last wide scatter carried to the camera, or taken on the light's side with an exact camera leg |
+// | `beam_photons`            | integer in [0, 2^24]          | 32768     | photons per light for the peak-only beam grid (0: straight beams) |
+// | `light_blur`              | boolean                       | true      | the first wide scatter sees the beam's light-side angular spread |
+// | `path_lengthening`        | boolean                       | false     | the corrected kernel's 1 / cosh loss on paths lengthened by peak deflections |
+// | `filtered_lookups`        | boolean                       | false     | scatter grid read pre-filtered over the camera-side lateral spread |
+// | `shadow_map_resolution`   | integer in [8, 1024]          | 64        | deep shadow map nodes along the longest axis |
+//
+// forward_side "light" needs light_path "forward" and photon_transport "exact": the other values are
+// errors naming both fields.
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "integrators/integrator.h"
 #include "integrators/scatter_grid.h"
 #include "integrators/shadow_map.h"
-#include "render/lights.h"
+#include "scene/lights.h"
 #include "transport/phase_split.h"
 
 namespace nimbus {
 
+enum class LightPath { forward, beer_lambert };
+enum class Propagator { gsa, gaussian };
+enum class PhotonTransport { exact, similarity };
+enum class ForwardSide { camera, light };
+
 struct MfsSettings {
-  double tau_step = 0.1;           // optical depth per march step (against the majorant)
-  double step_growth = 1.0;        // steps of tau_step (1 + step_growth tau_red), tau_red: camera-side
-  bool filtered_lookups = false;   // scatter grid looked up pre-filtered over the camera-side spread
-  bool forward_light_path = true;  // light_path: "forward" (true) or "beer_lambert"
-  bool gaussian = false;           // propagator: "gsa" (false) or "gaussian" (Gaussian stand-in for the peak)
-  double peak_fraction = -1.0;     // f in [0, 0.99]; < 0: "auto" (g^2 per medium)
-  bool path_lengthening = false;   // the 1 / cosh loss on paths lengthened by peak deflections
-  int beam_photons = 1 << 15;      // per light, for the peak-only beam grid (BeamGrid); 0: straight beams
-  bool light_blur = true;          // the first wide scatter sees the beam's light-side angular spread
-  bool light_side = false;        // forward_side "light": peak scatters on the light's side, exact camera leg
-  int large_angle_scatters = -1;  // K: at most K wide scatters per path (0: none, the peak only); -1 = "all"
+  double tau_step = 0.1;
+  double step_growth = 1.0;
+  LightPath light_path = LightPath::forward;
+  Propagator propagator = Propagator::gsa;
+  std::optional<double> peak_fraction;        // nullopt: "auto"
+  std::optional<int> large_angle_scatters;    // nullopt: "all"
+  int photons = 1 << 18;
+  PhotonTransport photon_transport = PhotonTransport::exact;
+  std::optional<int> scatter_grid_resolution;  // nullopt: "auto" (resolved by MfsIntegrator)
+  int scatter_grid_bands = 3;
+  ForwardSide forward_side = ForwardSide::camera;
+  int beam_photons = 1 << 15;
+  bool light_blur = true;
+  bool path_lengthening = false;
+  bool filtered_lookups = false;
   int shadow_map_resolution = 64;
-  ScatterGridSettings grid;  // the higher orders (K != 1): photons, resolution; seed from the scene
+
+  bool forward_light_path() const { return light_path == LightPath::forward; }
+  bool light_side() const { return forward_side == ForwardSide::light; }
 };
 
-MfsSettings parse_mfs_settings(const nlohmann::json& options, const std::string& where, bool strict,
-                               uint64_t seed = 1);
+// The integrator block's own fields (strict: unknown keys and conflicting fields are errors naming
+// `where` and the JSON paths), and back.
+MfsSettings mfs_settings_from_json(const nlohmann::json& options, const std::string& where);
+nlohmann::json to_json(const MfsSettings& s);
 
 class MfsIntegrator final : public Integrator {
  public:
-  MfsIntegrator(const SceneContext& context, MfsSettings settings);
-  Rgb sample(double px, double py, Rng& rng) const override;
+  // seed: the scene's, for the photon grids.
+  MfsIntegrator(const SceneContext& context, MfsSettings settings, uint64_t seed = 1);
+  Rgb Li(const Ray& ray, Rng& rng) const override { return radiance(ray.o, ray.d, rng); }
+  // The settings with "auto" resolved (scatter_grid_resolution).
+  nlohmann::json settings_json() const override { return to_json(s_); }
+  const MfsSettings& settings() const { return s_; }
   Rgb radiance(const Vec3& o, const Vec3& d, Rng& rng) const;
   const PhaseSplit& split(int medium) const { return *splits_[medium]; }
   const ScatterGrid* scatter_grid() const { return grid_.get(); }

@@ -3,12 +3,13 @@
 #include <cmath>
 
 #include "integrators/tracking.h"
-#include "io/json_reader.h"
-#include "render/lights.h"
+#include "media/phase.h"
+#include "core/json_reader.h"
+#include "scene/lights.h"
 
 namespace nimbus {
 
-OctaveSettings parse_octave_settings(const nlohmann::json& options, const std::string& where, bool strict) {
+OctaveSettings octave_settings_from_json(const nlohmann::json& options, const std::string& where) {
   OctaveSettings s;
   JsonObject o(options, where, "/integrator");
   s.octaves = int(o.integer("octaves", 1, 32, s.octaves));
@@ -17,8 +18,13 @@ OctaveSettings parse_octave_settings(const nlohmann::json& options, const std::s
   s.c = o.number("c", 0.0, 1.0, s.c);
   s.tau_step = o.number("tau_step", 1e-4, 100.0, s.tau_step);
   s.shadow_map_resolution = int(o.integer("shadow_map_resolution", 8, 1024, s.shadow_map_resolution));
-  if (strict) o.finish();
+  o.finish();
   return s;
+}
+
+nlohmann::json to_json(const OctaveSettings& s) {
+  return {{"octaves", s.octaves}, {"a", s.a},     {"b", s.b},
+          {"c", s.c},             {"tau_step", s.tau_step}, {"shadow_map_resolution", s.shadow_map_resolution}};
 }
 
 Phase scale_phase_eccentricity(const Phase& phase, double scale) {
@@ -48,11 +54,8 @@ OctaveIntegrator::OctaveIntegrator(const SceneContext& context, OctaveSettings s
     maps_.emplace_back(ctx_.media, ctx_.majorants, l, s_.shadow_map_resolution, 0.05);
 }
 
-Rgb OctaveIntegrator::sample(double px, double py, Rng& rng) const {
-  return radiance(ctx_.camera.origin(), ctx_.camera.direction(px, py), rng);
-}
-
-Rgb OctaveIntegrator::radiance(const Vec3& o, const Vec3& d, Rng& rng) const {
+Rgb OctaveIntegrator::Li(const Ray& ray, Rng& rng) const {
+  const Vec3 &o = ray.o, &d = ray.d;
   const int N = s_.octaves;
   std::vector<double> aj(N), bj(N);
   for (int j = 0; j < N; ++j) {

@@ -8,6 +8,17 @@
 // Light transmittance: one deep shadow map per light of exp(-tau), octave j reads T^(b^j) (exact for
 // the scaled extinction, which scales tau uniformly). The environment: one direction per octave sampled
 // from that octave's phase function, marched transmittance. A baseline, not physics: a, b, c are knobs.
+//
+// Options (the JSON fields of the scene's integrator block besides type, spp, seed, max_events):
+//
+// | field                   | type                  | default | meaning                                      |
+// |-------------------------|-----------------------|---------|----------------------------------------------|
+// | `octaves`               | integer in [1, 32]    | 4       | N, the number of single-scattering passes     |
+// | `a`                     | number in [0, 1]      | 0.5     | octave j scales scattering by a^j             |
+// | `b`                     | number in [0, 1]      | 0.5     | octave j scales extinction by b^j             |
+// | `c`                     | number in [0, 1]      | 0.5     | octave j scales the phase function's eccentricity by c^j |
+// | `tau_step`              | number in [1e-4, 100] | 0.1     | optical depth per march step                  |
+// | `shadow_map_resolution` | integer in [8, 1024]  | 64      | deep shadow map nodes along the longest axis  |
 #pragma once
 
 #include <vector>
@@ -24,7 +35,9 @@ struct OctaveSettings {
   int shadow_map_resolution = 64;
 };
 
-OctaveSettings parse_octave_settings(const nlohmann::json& options, const std::string& where, bool strict);
+// The integrator block's own fields (strict), and back.
+OctaveSettings octave_settings_from_json(const nlohmann::json& options, const std::string& where);
+nlohmann::json to_json(const OctaveSettings& s);
 
 // Medium phase function with its eccentricity scaled by `scale` (see above).
 Phase scale_phase_eccentricity(const Phase& phase, double scale);
@@ -32,8 +45,8 @@ Phase scale_phase_eccentricity(const Phase& phase, double scale);
 class OctaveIntegrator final : public Integrator {
  public:
   OctaveIntegrator(const SceneContext& context, OctaveSettings settings);
-  Rgb sample(double px, double py, Rng& rng) const override;
-  Rgb radiance(const Vec3& o, const Vec3& d, Rng& rng) const;
+  Rgb Li(const Ray& ray, Rng& rng) const override;
+  nlohmann::json settings_json() const override { return to_json(s_); }
 
  private:
   const SceneContext& ctx_;

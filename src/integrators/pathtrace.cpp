@@ -1,30 +1,37 @@
 #include "integrators/pathtrace.h"
 
 #include "integrators/tracking.h"
-#include "io/json_reader.h"
-#include "render/lights.h"
+#include "core/json_reader.h"
+#include "scene/lights.h"
 
 namespace nimbus {
 
-PathTraceSettings parse_pathtrace_settings(const nlohmann::json& options, const std::string& where, bool strict) {
+PathTraceSettings pathtrace_settings_from_json(const nlohmann::json& options, const std::string& where) {
   PathTraceSettings s;
   JsonObject o(options, where, "/integrator");
-  s.max_wide_scatters = int(o.integer("max_wide_scatters", 0, 1 << 20, -1));
-  if (o.has("peak_fraction") && o.raw("peak_fraction").is_string()) {
-    if (o.string("peak_fraction") != "auto") o.fail("peak_fraction", "must be \"auto\" or a number in [0, 0.99]");
-  } else {
-    s.peak_fraction = o.number("peak_fraction", 0.0, 0.99, -1.0);
-  }
-  if (strict) o.finish();
+  if (const auto k = o.optional_integer("max_wide_scatters", 0, 1 << 20)) s.max_wide_scatters = int(*k);
+  if (double f = 0.0; o.keyword_or_number("peak_fraction", "auto", 0.0, 0.99, &f)) s.peak_fraction = f;
+  o.finish();
   return s;
+}
+
+nlohmann::json to_json(const PathTraceSettings& s) {
+  nlohmann::json j = nlohmann::json::object();
+  if (s.max_wide_scatters) j["max_wide_scatters"] = *s.max_wide_scatters;
+  if (s.peak_fraction) {
+    j["peak_fraction"] = *s.peak_fraction;
+  } else {
+    j["peak_fraction"] = "auto";
+  }
+  return j;
 }
 
 PathTracer::PathTracer(const SceneContext& context, int max_events, PathTraceSettings settings)
     : ctx_(context), max_events_(max_events), s_(settings) {
-  if (s_.max_wide_scatters < 0) return;
+  if (!s_.max_wide_scatters) return;
   for (int i = 0; i < ctx_.media.count(); ++i) {
     const Phase& phase = ctx_.media.phase(i);
-    const double f = s_.peak_fraction < 0.0 ? std::min(0.99, auto_peak_fraction(phase)) : s_.peak_fraction;
+    const double f = s_.peak_fraction ? *s_.peak_fraction : std::min(0.99, auto_peak_fraction(phase));
     splits_.push_back(std::make_unique<PhaseSplit>(phase, f));
   }
 }
@@ -34,12 +41,8 @@ double PathTracer::split_weight(int medium, double mu, int wide) const {
   const PhaseSplit& split = *splits_[medium];
   const double p = phase_eval(ctx_.media.phase(medium), mu);
   const double share = p > 0.0 ? std::clamp((1.0 - split.f()) * split.wide(mu) / p, 0.0, 1.0) : 1.0;
-  const int K = s_.max_wide_scatters;
+  const int K = *s_.max_wide_scatters;
   return (wide + 1 <= K ? share : 0.0) + (wide <= K ? 1.0 - share : 0.0);
-}
-
-Rgb PathTracer::sample(double px, double py, Rng& rng) const {
-  return radiance(ctx_.camera.origin(), ctx_.camera.direction(px, py), rng);
 }
 
 Rgb PathTracer::direct_light(const Vec3& p, const Vec3& d, int medium, int wide_scatters, Rng& rng) const {
@@ -66,9 +69,9 @@ Rgb PathTracer::direct_light(const Vec3& p, const Vec3& d, int medium, int wide_
   return L;
 }
 
-Rgb PathTracer::radiance(const Vec3& origin, const Vec3& direction, Rng& rng) const {
+Rgb PathTracer::Li(const Ray& ray, Rng& rng) const {
   Rgb L(0.0), beta(1.0);
-  Vec3 o = origin, d = direction;
+  Vec3 o = ray.o, d = ray.d;
   int wide = 0;  // wide scatters so far (with a wide-scatter limit)
   MediumPoint mp;
   for (int events = 0;; ++events) {
@@ -128,7 +131,7 @@ Rgb PathTracer::radiance(const Vec3& origin, const Vec3& direction, Rng& rng) co
       const PhaseSplit& split = *splits_[scatter_medium];
       const double mu = dot(d, d_new), p = phase_eval(ctx_.media.phase(scatter_medium), mu);
       const double share = p > 0.0 ? (1.0 - split.f()) * split.wide(mu) / p : 1.0;
-      if (rng.uniform() < share && ++wide > s_.max_wide_scatters) break;
+      if (rng.uniform() < share && ++wide > *s_.max_wide_scatters) break;
     }
     d = d_new;
     o = scatter_p;

@@ -6,9 +6,17 @@
 // history-aware spectral tracking); next-event estimation to every light
 // with ratio-tracked transmittance (the environment through a phase-sampled direction); exact
 // phase sampling; unbiased Russian roulette.
+//
+// Options (the JSON fields of the scene's integrator block besides type, spp, seed, max_events):
+//
+// | field               | type                    | default | meaning                                        |
+// |---------------------|-------------------------|---------|------------------------------------------------|
+// | `max_wide_scatters` | integer >= 0 (or absent) | absent  | count only paths with at most K wide scatters (mfs's partition, for validating mfs order by order); absent: the full radiance |
+// | `peak_fraction`     | "auto" or [0, 0.99]     | "auto"  | f of the wide/peak split with max_wide_scatters ("auto": g^2 per medium, as mfs) |
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "integrators/integrator.h"
@@ -22,18 +30,20 @@ namespace nimbus {
 // (1 - f) P_wide(mu) / P(mu), a next-event connection contributes its wide and peak parts to the
 // right counts. Unbiased for that partition of the radiance; off (the full radiance) by default.
 struct PathTraceSettings {
-  int max_wide_scatters = -1;   // < 0: off
-  double peak_fraction = -1.0;  // < 0: auto (g^2), as mfs
+  std::optional<int> max_wide_scatters;  // nullopt: off (the full radiance)
+  std::optional<double> peak_fraction;   // nullopt: "auto" (g^2 per medium), as mfs
 };
 
-PathTraceSettings parse_pathtrace_settings(const nlohmann::json& options, const std::string& where, bool strict);
+// The integrator block's own fields (strict: unknown keys are errors naming `where` and the JSON path),
+// and back.
+PathTraceSettings pathtrace_settings_from_json(const nlohmann::json& options, const std::string& where);
+nlohmann::json to_json(const PathTraceSettings& s);
 
 class PathTracer final : public Integrator {
  public:
   PathTracer(const SceneContext& context, int max_events, PathTraceSettings settings = {});
-  Rgb sample(double px, double py, Rng& rng) const override;
-  // Radiance arriving at o from direction -d (a ray o + t d), for tests and other integrators.
-  Rgb radiance(const Vec3& o, const Vec3& d, Rng& rng) const;
+  Rgb Li(const Ray& ray, Rng& rng) const override;
+  nlohmann::json settings_json() const override { return to_json(s_); }
 
  private:
   // Next-event estimate at a scattering vertex p of medium `medium`, the path travelling along d.

@@ -4,7 +4,7 @@
 
 #include "core/trilinear.h"
 #include "integrators/tracking.h"
-#include "render/lights.h"
+#include "scene/lights.h"
 
 namespace nimbus {
 

@@ -1,28 +1,37 @@
 #include "integrators/single.h"
 
 #include "integrators/tracking.h"
-#include "io/json_reader.h"
-#include "render/lights.h"
+#include "media/phase.h"
+#include "core/json_reader.h"
+#include "scene/lights.h"
 
 namespace nimbus {
 
-SingleSettings parse_single_settings(const nlohmann::json& options, const std::string& where, bool strict) {
+namespace {
+const std::vector<std::string> kTransmittanceNames = {"ratio", "shadow_map"};
+}  // namespace
+
+SingleSettings single_settings_from_json(const nlohmann::json& options, const std::string& where) {
   SingleSettings s;
   JsonObject o(options, where, "/integrator");
   s.tau_step = o.number("tau_step", 1e-4, 100.0, s.tau_step);
   s.light_samples = int(o.integer("light_samples", 1, 1024, s.light_samples));
-  const std::string transmittance = o.string("transmittance", "ratio");
-  if (transmittance != "ratio" && transmittance != "shadow_map")
-    o.fail("transmittance", "must be \"ratio\" or \"shadow_map\"");
-  s.shadow_map = transmittance == "shadow_map";
+  s.transmittance = Transmittance(o.choice("transmittance", kTransmittanceNames, int(s.transmittance)));
   s.shadow_map_resolution = int(o.integer("shadow_map_resolution", 8, 1024, s.shadow_map_resolution));
-  if (strict) o.finish();
+  o.finish();
   return s;
+}
+
+nlohmann::json to_json(const SingleSettings& s) {
+  return {{"tau_step", s.tau_step},
+          {"light_samples", s.light_samples},
+          {"transmittance", kTransmittanceNames[int(s.transmittance)]},
+          {"shadow_map_resolution", s.shadow_map_resolution}};
 }
 
 SingleScatter::SingleScatter(const SceneContext& context, SingleSettings settings)
     : ctx_(context), s_(settings) {
-  if (s_.shadow_map) {
+  if (s_.transmittance == Transmittance::shadow_map) {
     for (const Light& l : ctx_.lights)
       shadow_maps_.emplace_back(ctx_.media, ctx_.majorants, l, s_.shadow_map_resolution, 0.05);
   }
@@ -33,11 +42,8 @@ Rgb SingleScatter::light_transmittance(size_t l, const Vec3& p, const LightSampl
   return ratio_tracking_transmittance(ctx_.media, ctx_.majorants, p, ls.wi, ls.distance, rng);
 }
 
-Rgb SingleScatter::sample(double px, double py, Rng& rng) const {
-  return radiance(ctx_.camera.origin(), ctx_.camera.direction(px, py), rng);
-}
-
-Rgb SingleScatter::radiance(const Vec3& o, const Vec3& d, Rng& rng) const {
+Rgb SingleScatter::Li(const Ray& ray, Rng& rng) const {
+  const Vec3 &o = ray.o, &d = ray.d;
   Rgb L(0.0), T(1.0);
   const double jitter = rng.uniform();
   MediumPoint mp;

@@ -4,32 +4,41 @@
 // one random offset per camera ray. Transmittance from each scattering point to the lights is exact
 // ratio tracking. Its mean matches `pathtrace` with max_events = 1 up to the step error of the
 // camera-side transmittance.
+//
+// Options (the JSON fields of the scene's integrator block besides type, spp, seed, max_events):
+//
+// | field                   | type                      | default | meaning                                   |
+// |-------------------------|---------------------------|---------|-------------------------------------------|
+// | `tau_step`              | number in [1e-4, 100]     | 0.1     | optical depth per march step against the local majorant |
+// | `light_samples`         | integer in [1, 1024]      | 1       | transmittance estimates per light per step |
+// | `transmittance`         | "ratio" or "shadow_map"   | "ratio" | to directional and point lights: exact ratio tracking, or a deep shadow map (deterministic, biased by its resolution); the environment always uses ratio tracking |
+// | `shadow_map_resolution` | integer in [8, 1024]      | 128     | shadow map nodes along the longest axis of the media's bounds |
 #pragma once
 
 #include "integrators/integrator.h"
 #include "integrators/shadow_map.h"
-#include "render/lights.h"
+#include "scene/lights.h"
 
 namespace nimbus {
 
+enum class Transmittance { ratio, shadow_map };
+
 struct SingleSettings {
-  double tau_step = 0.1;  // optical depth per march step (against the majorant)
-  int light_samples = 1;  // ratio-tracking estimates per light per step
-  // Transmittance to directional and point lights: exact ratio tracking, or a deep shadow map
-  // (deterministic, biased by its resolution). The environment always uses ratio tracking.
-  bool shadow_map = false;
-  int shadow_map_resolution = 128;  // nodes along the longest axis of the media's bounds
+  double tau_step = 0.1;
+  int light_samples = 1;
+  Transmittance transmittance = Transmittance::ratio;
+  int shadow_map_resolution = 128;
 };
 
-// Reads the integrator block's `single` options. strict: unknown keys are errors (the scene names
-// this integrator); otherwise other integrators' keys are ignored (--integrator override).
-SingleSettings parse_single_settings(const nlohmann::json& options, const std::string& where, bool strict);
+// The integrator block's own fields (strict), and back.
+SingleSettings single_settings_from_json(const nlohmann::json& options, const std::string& where);
+nlohmann::json to_json(const SingleSettings& s);
 
 class SingleScatter final : public Integrator {
  public:
   SingleScatter(const SceneContext& context, SingleSettings settings);
-  Rgb sample(double px, double py, Rng& rng) const override;
-  Rgb radiance(const Vec3& o, const Vec3& d, Rng& rng) const;
+  Rgb Li(const Ray& ray, Rng& rng) const override;
+  nlohmann::json settings_json() const override { return to_json(s_); }
 
  private:
   // Transmittance from p towards light l (index into ctx_.lights) along the sampled direction.

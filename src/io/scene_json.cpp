@@ -5,10 +5,11 @@
 
 #include <fmt/format.h>
 
-#include "io/json_reader.h"
-#include "integrators/integrator.h"
+#include "core/json_reader.h"
+#include "integrators/registry.h"
 #include "io/scene_volumes.h"
 #include "media/media.h"
+#include "media/phase.h"
 #include "nimbus/render.h"
 #include "nimbus/error.h"
 #include "nimbus/scene.h"

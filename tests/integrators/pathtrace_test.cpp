@@ -6,10 +6,11 @@
 #include <cstring>
 
 #include "integrators/pathtrace.h"
+#include "integrators/registry.h"
 #include "nimbus/error.h"
 #include "integrators/tracking.h"
 #include "nimbus/render.h"
-#include "render/lights.h"
+#include "scene/lights.h"
 #include "support/scenes.h"
 #include "support/stats.h"
 
@@ -27,7 +28,7 @@ ChannelStats estimate(const PathTracer& pt, const Vec3& o, const Vec3& d, int n,
   ChannelStats s;
   for (int i = 0; i < n; ++i) {
     Rng rng(seed, uint64_t(i));
-    const Rgb L = pt.radiance(o, d, rng);
+    const Rgb L = pt.Li({o, d}, rng);
     for (int k = 0; k < 3; ++k) s.c[k].add(L[k]);
   }
   return s;

@@ -25,7 +25,7 @@ TEST(Single, MatchesPathTracerWithOneEvent) {
     test::MeanAccumulator a[3], b[3];
     for (int i = 0; i < 5000; ++i) {
       Rng r1(1, i), r2(2, i);
-      const Rgb la = pt.radiance(Vec3(0, -4, 0), d, r1), lb = single.radiance(Vec3(0, -4, 0), d, r2);
+      const Rgb la = pt.Li({Vec3(0, -4, 0), d}, r1), lb = single.Li({Vec3(0, -4, 0), d}, r2);
       for (int k = 0; k < 3; ++k) {
         a[k].add(la[k]);
         b[k].add(lb[k]);
@@ -88,13 +88,13 @@ TEST(Single, ShadowMapAgreesWithRatioTracking) {
     "lights": [{"type": "directional", "direction": [0.5, 1, -0.3], "irradiance": 1.0}]})");
   const SceneContext ctx(scene);
   SingleSettings ratio{0.05, 1}, mapped{0.05, 1};
-  mapped.shadow_map = true;
+  mapped.transmittance = Transmittance::shadow_map;
   const SingleScatter a(ctx, ratio), b(ctx, mapped);
   test::MeanAccumulator ma, mb;
   for (int i = 0; i < 3000; ++i) {
     Rng r1(1, i), r2(2, i);
-    ma.add(a.radiance(Vec3(0, -4, 0), normalize(Vec3(0.1, 1, 0.1)), r1)[0]);
-    mb.add(b.radiance(Vec3(0, -4, 0), normalize(Vec3(0.1, 1, 0.1)), r2)[0]);
+    ma.add(a.Li({Vec3(0, -4, 0), normalize(Vec3(0.1, 1, 0.1))}, r1)[0]);
+    mb.add(b.Li({Vec3(0, -4, 0), normalize(Vec3(0.1, 1, 0.1))}, r2)[0]);
   }
   EXPECT_NEAR(mb.mean, ma.mean, 5 * std::hypot(ma.stderr_mean(), mb.stderr_mean()) + 0.01 * ma.mean);
 }

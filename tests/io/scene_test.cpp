@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "core/math.h"
 #include "nimbus/error.h"
 #include "support/scenes.h"
 

@@ -60,8 +60,8 @@ TEST(SceneVdb, MajorantGridIsUnbiasedOnTheDisneyCloud) {
     test::MeanAccumulator ma, mb;
     for (int i = 0; i < 4000; ++i) {
       Rng r1(1, i), r2(2, i);
-      ma.add(luminance(a.radiance(o, d, r1)));
-      mb.add(luminance(b.radiance(o, d, r2)));
+      ma.add(luminance(a.Li({o, d}, r1)));
+      mb.add(luminance(b.Li({o, d}, r2)));
     }
     EXPECT_NEAR(ma.mean, mb.mean, 5 * std::hypot(ma.stderr_mean(), mb.stderr_mean()));
   }

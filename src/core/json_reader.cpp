@@ -1,4 +1,4 @@
-#include "io/json_reader.h"
+#include "core/json_reader.h"
 
 #include <cmath>
 
@@ -179,6 +179,58 @@ void JsonObject::finish() const {
       fail(it.key(), fmt::format("unknown field (known here: {})", known));
     }
   }
+}
+
+int JsonObject::choice(const std::string& key, const std::vector<std::string>& names, int fallback) {
+  if (!has(key)) {
+    used_.insert(key);
+    return fallback;
+  }
+  const std::string v = string(key);
+  for (size_t i = 0; i < names.size(); ++i)
+    if (v == names[i]) return int(i);
+  std::string list;
+  for (size_t i = 0; i < names.size(); ++i)
+    list += (i == 0 ? "" : (names.size() == 2 ? " or " : ", ")) + ("\"" + names[i] + "\"");
+  fail(key, names.size() == 2 ? "must be " + list : "must be one of " + list);
+}
+
+std::optional<int64_t> JsonObject::optional_integer(const std::string& key, int64_t lo, int64_t hi) {
+  if (!has(key)) {
+    used_.insert(key);  // a known field: listed in the unknown-field message
+    return std::nullopt;
+  }
+  return integer(key, lo, hi);
+}
+
+bool JsonObject::keyword_or_number(const std::string& key, const std::string& keyword, double lo, double hi,
+                                   double* value) {
+  if (!has(key)) {
+    used_.insert(key);
+    return false;
+  }
+  if (raw(key).is_string()) {
+    if (string(key) != keyword)
+      fail(key, fmt::format("must be \"{}\" or a number in [{}, {}]", keyword, fmt_bound(lo), fmt_bound(hi)));
+    return false;
+  }
+  *value = number(key, lo, hi);
+  return true;
+}
+
+bool JsonObject::keyword_or_integer(const std::string& key, const std::string& keyword, int64_t lo, int64_t hi,
+                                    int64_t* value) {
+  if (!has(key)) {
+    used_.insert(key);
+    return false;
+  }
+  if (raw(key).is_string()) {
+    if (string(key) != keyword)
+      fail(key, fmt::format("must be \"{}\" or an integer in [{}, {}]", keyword, lo, hi));
+    return false;
+  }
+  *value = integer(key, lo, hi);
+  return true;
 }
 
 }  // namespace nimbus

@@ -2,6 +2,7 @@
 // every error a nimbus::Error "FILE: /json/pointer: message".
 #pragma once
 
+#include <optional>
 #include <set>
 #include <string>
 #include <vector>
@@ -32,9 +33,18 @@ class JsonObject {
   double number_open_below(const std::string& key, double lo, double hi);  // lo < x <= hi
   int64_t integer(const std::string& key, int64_t lo, int64_t hi);
   int64_t integer(const std::string& key, int64_t lo, int64_t hi, int64_t fallback);
+  std::optional<int64_t> optional_integer(const std::string& key, int64_t lo, int64_t hi);  // nullopt: absent
   std::string string(const std::string& key);
   std::string string(const std::string& key, const std::string& fallback);
   bool boolean(const std::string& key, bool fallback);
+  // One of `names` (a string); returns its index, `fallback` when the key is absent.
+  // Message: must be "a" or "b" (or: must be one of "a", "b", "c").
+  int choice(const std::string& key, const std::vector<std::string>& names, int fallback);
+  // Either the string `keyword` (returns false: the caller keeps its "auto"-like default) or a number in
+  // [lo, hi] written to *value (returns true). Message: must be "keyword" or a number in [lo, hi].
+  bool keyword_or_number(const std::string& key, const std::string& keyword, double lo, double hi, double* value);
+  bool keyword_or_integer(const std::string& key, const std::string& keyword, int64_t lo, int64_t hi,
+                          int64_t* value);
   Vec3 vec3(const std::string& key);
   Vec3 vec3(const std::string& key, const Vec3& fallback);
   // A number (grey) or [r, g, b], each component >= lo.

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "core/math.h"
+#include "core/ray.h"
 #include "nimbus/scene.h"
 
 namespace nimbus {
@@ -27,6 +28,8 @@ class PinholeCamera {
     const double sy = (1.0 - 2.0 * py / height_) * tan_half_;
     return normalize(forward_ + right_ * sx + up_ * sy);
   }
+  // The camera ray through image position (px, py).
+  Ray generate_ray(double px, double py) const { return {origin_, direction(px, py)}; }
 
  private:
   Vec3 origin_, forward_, right_, up_;

@@ -1,4 +1,4 @@
-#include "render/lights.h"
+#include "scene/lights.h"
 
 namespace nimbus {
 

@@ -1,0 +1,17 @@
+#include "scene/context.h"
+
+namespace nimbus {
+
+SceneContext::SceneContext(const Scene& scene, int majorant_resolution, bool global_majorant)
+    : media(scene.media), majorants(media, majorant_resolution, global_majorant), camera(scene.camera) {
+  for (const Light& l : scene.lights) {
+    if (const auto* env = std::get_if<EnvironmentLight>(&l)) {
+      environment += env->radiance;
+      has_environment = true;
+    } else {
+      lights.push_back(l);
+    }
+  }
+}
+
+}  // namespace nimbus
