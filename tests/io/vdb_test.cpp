@@ -27,7 +27,7 @@ using test::shared_volume;
 const DensityGrid& cached(const char* name) {
   static std::map<std::string, DensityGrid> grids;
   auto it = grids.find(name);
-  if (it == grids.end()) it = grids.emplace(name, DensityGrid::load(shared_volume(name))).first;
+  if (it == grids.end()) it = grids.emplace(name, load_density_grid(shared_volume(name))).first;
   return it->second;
 }
 
@@ -93,7 +93,7 @@ TEST(VdbLoad, WorldIndexMapsAndBounds) {
 
 TEST(VdbLoad, CopiesShareAndOutliveTheOriginal) {
   NIMBUS_REQUIRE_FILE(shared_volume(kSmoke));
-  std::optional<DensityGrid> a = DensityGrid::load(shared_volume(kSmoke));
+  std::optional<DensityGrid> a = load_density_grid(shared_volume(kSmoke));
   const Vec3 p(50.3, 100.7, 40.2);
   const double d = a->density_index(p);
   DensityGrid b = *a;
@@ -267,7 +267,7 @@ TEST_P(VdbCorrupt, BitFlipsNeverCrash) {
     test::write_bytes(file, b);
     const auto t0 = std::chrono::steady_clock::now();
     try {
-      const DensityGrid g = DensityGrid::load(file);
+      const DensityGrid g = load_density_grid(file);
       // A grid that loads must be usable.
       (void)g.density_index((g.index_lo() + g.index_hi()) * 0.5);
       (void)g.max_density_index(g.index_lo(), g.index_hi());
