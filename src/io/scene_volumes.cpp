@@ -1,3 +1,4 @@
+// The volumes of a scene (scene_volumes.h): .vdb/.nvdb shapes loaded, procedural clouds voxelised.
 #include "io/scene_volumes.h"
 
 #include <nanovdb/util/GridBuilder.h>
