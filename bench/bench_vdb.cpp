@@ -10,6 +10,7 @@
 namespace {
 
 using nimbus::DensityGrid;
+using nimbus::load_density_grid;
 using nimbus::Vec3;
 
 std::filesystem::path volume(const char* name) {
