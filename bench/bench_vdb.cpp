@@ -10,6 +10,7 @@
 namespace {
 
 using nimbus::DensityGrid;
+using nimbus::load_density_grid;
 using nimbus::Vec3;
 
 std::filesystem::path volume(const char* name) {
@@ -21,7 +22,7 @@ void BM_Load(benchmark::State& state) {
   const auto file = volume(kFiles[state.range(0)]);
   double read = 0, analyse = 0;
   for (auto _ : state) {
-    const DensityGrid g = DensityGrid::load(file);
+    const DensityGrid g = load_density_grid(file);
     read += g.stats().read_seconds;
     analyse += g.stats().analyse_seconds;
   }
@@ -46,7 +47,7 @@ std::vector<Vec3> ray_points(const DensityGrid& g, size_t n) {
 }
 
 void BM_DensityIndex(benchmark::State& state) {
-  const DensityGrid g = DensityGrid::load(volume(kFiles[state.range(0)]));
+  const DensityGrid g = load_density_grid(volume(kFiles[state.range(0)]));
   const auto pts = ray_points(g, 1 << 16);
   size_t i = 0;
   for (auto _ : state) benchmark::DoNotOptimize(g.density_index(pts[i++ & 0xffff]));
@@ -55,7 +56,7 @@ void BM_DensityIndex(benchmark::State& state) {
 BENCHMARK(BM_DensityIndex)->Arg(0)->Arg(1);
 
 void BM_SamplerDensity(benchmark::State& state) {
-  const DensityGrid g = DensityGrid::load(volume(kFiles[state.range(0)]));
+  const DensityGrid g = load_density_grid(volume(kFiles[state.range(0)]));
   const auto pts = ray_points(g, 1 << 16);
   DensityGrid::Sampler s(g);
   size_t i = 0;
@@ -65,7 +66,7 @@ void BM_SamplerDensity(benchmark::State& state) {
 BENCHMARK(BM_SamplerDensity)->Arg(0)->Arg(1);
 
 void BM_MaxDensityIndex(benchmark::State& state) {
-  const DensityGrid g = DensityGrid::load(volume(kFiles[0]));
+  const DensityGrid g = load_density_grid(volume(kFiles[0]));
   const auto pts = ray_points(g, 1 << 16);
   size_t i = 0;
   for (auto _ : state) {

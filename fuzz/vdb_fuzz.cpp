@@ -1,4 +1,4 @@
-// libFuzzer target: volume file bytes -> a temporary file -> DensityGrid::load and
+// libFuzzer target: volume file bytes -> a temporary file -> load_density_grid and
 // inspect_volume_file (`nimbus info`). The loader picks the reader (OpenVDB or NanoVDB) from the magic
 // number, never from the extension, so one load covers .vdb and .nvdb alike; the seeds hold both.
 // A loaded grid is sampled at its corners, its centre and a few points derived from the input, through
@@ -77,7 +77,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   static const fs::path file = temp_path(".vdb");
   write_file(file, data, size);
   try {
-    const nimbus::DensityGrid g = nimbus::DensityGrid::load(file);
+    const nimbus::DensityGrid g = nimbus::load_density_grid(file);
     sample(g, data, size);
   } catch (const nimbus::Error&) {
   }

@@ -8,16 +8,14 @@
 //   unscattered lo = hi = 0; unscattered flux through the plane
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
-#include <fstream>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include <fmt/format.h>
-#include <unistd.h>
 
 #include "commands.h"
+#include "io/atomic_file.h"
 #include "nimbus/error.h"
 #include "transport/beam_table.h"
 #include "transport/phase_spec.h"
@@ -42,27 +40,6 @@ std::vector<std::string> split_names(const std::string& list) {
   while (std::getline(ss, item, ','))
     if (!item.empty()) v.push_back(item);
   return v;
-}
-
-// Writes `text` to `path` atomically: a temporary file beside it, then rename.
-void write_atomically(const std::string& path, const std::string& text) {
-  const std::string tmp = fmt::format("{}.tmp-{}", path, ::getpid());
-  {
-    std::ofstream out(tmp, std::ios::binary);
-    out << text;
-    out.flush();
-    if (!out) {
-      std::error_code ec;
-      std::filesystem::remove(tmp, ec);
-      throw std::runtime_error(fmt::format("cannot write {}", path));
-    }
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) {
-    std::filesystem::remove(tmp, ec);
-    throw std::runtime_error(fmt::format("cannot write {}", path));
-  }
 }
 
 int run_beam(const BeamArgs& a) {
@@ -98,9 +75,9 @@ int run_beam(const BeamArgs& a) {
     std::fwrite(text.data(), 1, text.size(), stdout);
   } else {
     try {
-      write_atomically(a.out, text);
-    } catch (const std::runtime_error& e) {
-      fmt::print(stderr, "nimbus: error: {}\n", e.what());
+      atomic_write_bytes(a.out, text);
+    } catch (const Error&) {
+      fmt::print(stderr, "nimbus: error: cannot write {}\n", a.out);
       return kExitFailure;
     }
   }

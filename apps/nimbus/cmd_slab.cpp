@@ -6,16 +6,14 @@
 //   solid angle, exit polar angle outside the slab, rad) or radial (per unit area, exit radius).
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
-#include <fstream>
 #include <string>
 #include <vector>
 
 #include <fmt/format.h>
-#include <unistd.h>
 
 #include "commands.h"
 #include "core/math.h"
+#include "io/atomic_file.h"
 #include "nimbus/error.h"
 #include "transport/photon_mc.h"
 
@@ -83,22 +81,9 @@ int run_slab(const SlabArgs& a) {
     std::fwrite(csv.data(), 1, csv.size(), stdout);
     return kExitOk;
   }
-  const std::string tmp = fmt::format("{}.tmp-{}", a.csv_path, ::getpid());
-  {
-    std::ofstream out(tmp, std::ios::binary);
-    out << csv;
-    out.flush();
-    if (!out) {
-      std::error_code ec;
-      std::filesystem::remove(tmp, ec);
-      fmt::print(stderr, "nimbus: error: cannot write {}\n", a.csv_path);
-      return kExitFailure;
-    }
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, a.csv_path, ec);
-  if (ec) {
-    std::filesystem::remove(tmp, ec);
+  try {
+    atomic_write_bytes(a.csv_path, csv);
+  } catch (const Error&) {
     fmt::print(stderr, "nimbus: error: cannot write {}\n", a.csv_path);
     return kExitFailure;
   }

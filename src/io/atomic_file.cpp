@@ -1,3 +1,4 @@
+// Atomic file output (atomic_file.h): a temporary file beside the target, flushed, then renamed.
 #include "io/atomic_file.h"
 
 #include <fcntl.h>

@@ -1,3 +1,4 @@
+// Image comparison metrics and the error heat map (nimbus/compare.h).
 #include "nimbus/compare.h"
 
 #include <algorithm>

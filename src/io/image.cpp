@@ -1,3 +1,4 @@
+// Image files (nimbus/image.h): EXR read and write, sRGB PNG output, both written atomically.
 #include "nimbus/image.h"
 
 #include <png.h>

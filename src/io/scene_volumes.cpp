@@ -1,3 +1,4 @@
+// The volumes of a scene (scene_volumes.h): .vdb/.nvdb shapes loaded, procedural clouds voxelised.
 #include "io/scene_volumes.h"
 
 #include <nanovdb/util/GridBuilder.h>
@@ -15,7 +16,7 @@ void load_vdb_shape(VdbShape& v, const std::filesystem::path& base_dir, const st
   const std::filesystem::path file = std::filesystem::path(v.file).is_absolute() ? std::filesystem::path(v.file)
                                                                                    : base_dir / v.file;
   try {
-    v.data = std::make_shared<const DensityGrid>(DensityGrid::load(file, v.grid));
+    v.data = std::make_shared<const DensityGrid>(load_density_grid(file, v.grid));
   } catch (const Error& e) {
     throw Error(fmt::format("{}: {}/file: {}", where, json_path, e.what()));
   }

@@ -25,8 +25,6 @@ NanoHandle load_openvdb_float_grid(const std::filesystem::path& file, const std:
 // Every grid of an OpenVDB file, for `nimbus info`.
 std::vector<GridInfo> inspect_openvdb_file(const std::filesystem::path& file);
 
-// Index bboxes with more voxels than this are rejected (a corrupt file or a grid we cannot brick).
-inline constexpr double kMaxBBoxVoxels = 2147483648.0;  // 2^31
 // Voxel index coordinates must lie in [-2^30, 2^30): far inside int32, so node and bbox arithmetic
 // (origin + node size, max + 1) cannot overflow.
 inline constexpr int kMaxIndexCoord = 1 << 30;

@@ -2,7 +2,7 @@
 
 #include <tbb/parallel_for.h>
 
-#include "io/vdb.h"
+#include "media/density_grid.h"
 
 namespace nimbus {
 

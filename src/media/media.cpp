@@ -2,7 +2,7 @@
 
 #include <fmt/format.h>
 
-#include "io/vdb.h"
+#include "media/density_grid.h"
 #include "nimbus/error.h"
 
 namespace nimbus {

@@ -1,3 +1,6 @@
+// The beam table behind `nimbus beam`: photon Monte Carlo and every deterministic propagator (Dolin,
+// Tessendorf 87, MFS, generalised small-angle) tallied in the same angular and radial bins at planes
+// of given optical depth.
 #include "transport/beam_table.h"
 
 #include <algorithm>
@@ -39,7 +42,10 @@ const std::vector<std::string>& beam_model_names() {
   return names;
 }
 
-std::vector<BeamRow> beam_table(const BeamSettings& in, const std::vector<std::string>& models) {
+namespace {
+
+// The settings with defaults filled in, after checking them and the model names.
+BeamSettings checked_beam_settings(const BeamSettings& in, const std::vector<std::string>& models) {
   BeamSettings s = in;
   if (!(s.albedo > 0.0 && s.albedo <= 1.0)) throw Error(fmt::format("albedo must lie in (0, 1] (got {})", s.albedo));
   if (s.depths.empty()) throw Error("at least one depth is needed");
@@ -55,76 +61,93 @@ std::vector<BeamRow> beam_table(const BeamSettings& in, const std::vector<std::s
   for (const auto& m : models)
     if (m != "mc_fwd" && std::find(beam_model_names().begin(), beam_model_names().end(), m) == beam_model_names().end())
       throw Error(fmt::format("unknown model '{}' (known: mc, dolin, tes87, mfs, gsa; diagnostic: mc_fwd)", m));
-  const bool want_fwd = std::find(models.begin(), models.end(), "mc_fwd") != models.end();
+  return s;
+}
 
-  const double a = (1.0 - s.albedo) / s.albedo;  // absorption per scattering length
-  const bool slab = std::isfinite(s.thickness);
-  const double entry = slab ? 1.0 - fresnel_reflectance(1.0, s.n, 1.0) : 1.0;
+// Rows of a deterministic model at depth z from its cumulative angular and radial power; `entry` is
+// the fraction that enters the medium, `a` the absorption per scattering length.
+template <typename WithinAngle, typename WithinRadius>
+void add_model_rows(std::vector<BeamRow>& rows, const BeamSettings& s, const std::string& name, double z, double entry,
+                    double a, WithinAngle&& within_angle, WithinRadius&& within_radius) {
   const auto& te = s.theta_edges;
   const auto& re = s.r_edges;
   auto solid_angle = [&](size_t i) { return 2.0 * kPi * (std::cos(te[i]) - std::cos(te[i + 1])); };
   auto area = [&](size_t i) { return kPi * (re[i + 1] * re[i + 1] - re[i] * re[i]); };
+  double prev = within_angle(te[0]);
+  for (size_t i = 0; i + 1 < te.size(); ++i) {
+    const double next = within_angle(te[i + 1]);
+    rows.push_back({name, z, "angular", te[i], te[i + 1], entry * (next - prev) / solid_angle(i), 0.0});
+    prev = next;
+  }
+  prev = within_radius(re[0]);
+  for (size_t i = 0; i + 1 < re.size(); ++i) {
+    const double next = within_radius(re[i + 1]);
+    rows.push_back({name, z, "radial", re[i], re[i + 1], entry * (next - prev) / area(i), 0.0});
+    prev = next;
+  }
+  rows.push_back({name, z, "unscattered", 0.0, 0.0, entry * std::exp(-(1.0 + a) * z), 0.0});
+}
+
+// The photon Monte Carlo rows: "mc" if asked, the forward-only "mc_fwd" diagnostic if want_fwd.
+void add_mc_rows(std::vector<BeamRow>& rows, const BeamSettings& s, double a, bool asked, bool want_fwd) {
+  const auto& te = s.theta_edges;
+  const auto& re = s.r_edges;
+  PhotonMcSettings mc;
+  mc.sigma_s = 1.0;
+  mc.sigma_a = a;
+  mc.phase = s.phase;
+  mc.thickness = s.thickness;
+  mc.n = s.n;
+  mc.plane_depths = s.depths;
+  mc.theta_edges = te;
+  mc.r_edges = re;
+  mc.photons = s.photons;
+  mc.seed = s.seed;
+  mc.batches = s.batches;
+  const PhotonMcResult r = run_photon_mc(mc);
+  for (const PlaneTally& t : r.planes) {
+    if (want_fwd)
+      for (size_t i = 0; i < t.angular.size(); ++i)
+        rows.push_back({"mc_fwd", t.depth, "angular", te[i], te[i + 1], t.angular_forward_only[i].value,
+                        t.angular_forward_only[i].err});
+    if (!asked) continue;
+    for (size_t i = 0; i < t.angular.size(); ++i)
+      rows.push_back({"mc", t.depth, "angular", te[i], te[i + 1], t.angular[i].value, t.angular[i].err});
+    for (size_t i = 0; i < t.radial.size(); ++i)
+      rows.push_back({"mc", t.depth, "radial", re[i], re[i + 1], t.radial[i].value, t.radial[i].err});
+    rows.push_back({"mc", t.depth, "unscattered", 0.0, 0.0, t.unscattered.value, t.unscattered.err});
+  }
+}
+
+}  // namespace
+
+std::vector<BeamRow> beam_table(const BeamSettings& in, const std::vector<std::string>& models) {
+  const BeamSettings s = checked_beam_settings(in, models);
+  const bool want_fwd = std::find(models.begin(), models.end(), "mc_fwd") != models.end();
+  const double a = (1.0 - s.albedo) / s.albedo;  // absorption per scattering length
+  const bool slab = std::isfinite(s.thickness);
+  const double entry = slab ? 1.0 - fresnel_reflectance(1.0, s.n, 1.0) : 1.0;
 
   std::vector<BeamRow> rows;
-  // Rows of a deterministic model from its cumulative angular and radial power.
-  auto add_model = [&](const std::string& name, double z, auto&& within_angle, auto&& within_radius) {
-    double prev = within_angle(te[0]);
-    for (size_t i = 0; i + 1 < te.size(); ++i) {
-      const double next = within_angle(te[i + 1]);
-      rows.push_back({name, z, "angular", te[i], te[i + 1], entry * (next - prev) / solid_angle(i), 0.0});
-      prev = next;
-    }
-    prev = within_radius(re[0]);
-    for (size_t i = 0; i + 1 < re.size(); ++i) {
-      const double next = within_radius(re[i + 1]);
-      rows.push_back({name, z, "radial", re[i], re[i + 1], entry * (next - prev) / area(i), 0.0});
-      prev = next;
-    }
-    rows.push_back({name, z, "unscattered", 0.0, 0.0, entry * std::exp(-(1.0 + a) * z), 0.0});
-  };
-
-  std::vector<std::string> order = beam_model_names();
-  for (const std::string& m : order) {
+  for (const std::string& m : beam_model_names()) {
     const bool asked = std::find(models.begin(), models.end(), m) != models.end();
     if (!asked && !(m == "mc" && want_fwd)) continue;
     if (m == "mc") {
-      PhotonMcSettings mc;
-      mc.sigma_s = 1.0;
-      mc.sigma_a = a;
-      mc.phase = s.phase;
-      mc.thickness = s.thickness;
-      mc.n = s.n;
-      mc.plane_depths = s.depths;
-      mc.theta_edges = te;
-      mc.r_edges = re;
-      mc.photons = s.photons;
-      mc.seed = s.seed;
-      mc.batches = s.batches;
-      const PhotonMcResult r = run_photon_mc(mc);
-      for (const PlaneTally& t : r.planes) {
-        if (want_fwd)
-          for (size_t i = 0; i < t.angular.size(); ++i)
-            rows.push_back({"mc_fwd", t.depth, "angular", te[i], te[i + 1], t.angular_forward_only[i].value,
-                            t.angular_forward_only[i].err});
-        if (!asked) continue;
-        for (size_t i = 0; i < t.angular.size(); ++i)
-          rows.push_back({"mc", t.depth, "angular", te[i], te[i + 1], t.angular[i].value, t.angular[i].err});
-        for (size_t i = 0; i < t.radial.size(); ++i)
-          rows.push_back({"mc", t.depth, "radial", re[i], re[i + 1], t.radial[i].value, t.radial[i].err});
-        rows.push_back({"mc", t.depth, "unscattered", 0.0, 0.0, t.unscattered.value, t.unscattered.err});
-      }
+      add_mc_rows(rows, s, a, asked, want_fwd);
     } else if (m == "gsa") {
       const ForwardPropagator prop(s.phase);
       for (double z : s.depths) {
         const ForwardProfile p = prop.profile(z, a * z);
-        add_model(m, z, [&](double t) { return p.angular_within(t); }, [&](double r) { return p.radial_within(r); });
+        add_model_rows(rows, s, m, z, entry, a, [&](double t) { return p.angular_within(t); },
+                       [&](double r) { return p.radial_within(r); });
       }
     } else {
       const GaussianModel gm = m == "dolin" ? GaussianModel::Dolin : m == "tes87" ? GaussianModel::Tes87 : GaussianModel::Mfs;
       const double theta2 = phase_theta2(s.phase);
       for (double z : s.depths) {
         const GaussianBeam g = gaussian_beam(gm, z, z, a * z, theta2);
-        add_model(m, z, [&](double t) { return g.angular_within(t); }, [&](double r) { return g.radial_within(r); });
+        add_model_rows(rows, s, m, z, entry, a, [&](double t) { return g.angular_within(t); },
+                       [&](double r) { return g.radial_within(r); });
       }
     }
   }

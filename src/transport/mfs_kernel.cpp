@@ -1,3 +1,4 @@
+// The MFS Green's function and the older small-angle beam forms (mfs_kernel.h).
 #include "transport/mfs_kernel.h"
 
 #include <cmath>

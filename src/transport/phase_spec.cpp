@@ -1,3 +1,4 @@
+// Phase functions from short command-line specs (phase_spec.h).
 #include "transport/phase_spec.h"
 
 #include <cmath>

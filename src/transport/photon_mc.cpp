@@ -1,3 +1,5 @@
+// Photon Monte Carlo of a pencil beam in a slab or an infinite medium (MCML conventions): the tracer,
+// the tallies at planes and faces, and batch-mean error estimates (photon_mc.h).
 #include "transport/photon_mc.h"
 
 #include <algorithm>
@@ -124,44 +126,56 @@ class Tracer {
       p = p1;
 
       if (hits) {
-        // Fresnel at the face: the transmitted part leaves, the reflected part goes on.
-        double cos_t = 0.0;
-        const double R = fresnel_reflectance(s_.n, 1.0, d.z, &cos_t);
-        const double wt = w * (1.0 - R);
-        if (wt > 0.0) tally_exit(d.z > 0.0, std::acos(std::clamp(cos_t, 0.0, 1.0)), p, wt, scattered, acc);
-        w *= R;
-        d.z = -d.z;
-        turned = turned || d.z <= 0.0;
+        reflect_at_face(p, d, w, scattered, turned, acc);
         if (!(w > 0.0)) return;
       } else {
-        // Interaction: deposit the absorbed fraction, scatter the rest.
-        const double dep = w * s_.sigma_a / sigma_t_;
-        acc[L_.totals() + kAbsorbed] += dep;
-        w -= dep;
-        const double u1 = rng.uniform(), u2 = rng.uniform();
-        d = normalize(phase_sample(s_.phase, d, u1, u2));
-        scattered = true;
-        turned = turned || d.z <= 0.0;
+        interact(rng, d, w, scattered, turned, acc);
       }
-
-      // Russian roulette on weight (MCML): survive with probability 0.1 at weight / 0.1.
-      if (w < kRouletteThreshold) {
-        if (rng.uniform() < kRouletteSurvival) w /= kRouletteSurvival;
-        else return;
-      }
-      // Infinite medium: depth roulette, halving the population per transport length beyond the tallies.
-      if (!slab_) {
-        const double zone = std::max(std::floor((p.z - z_last_) / zone_len_), std::floor(-p.z / zone_len_));
-        while (zone > zone_seen) {
-          ++zone_seen;
-          if (rng.uniform() < 0.5) w *= 2.0;
-          else return;
-        }
-      }
+      if (!survives_roulette(rng, p, w, zone_seen)) return;
     }
   }
 
  private:
+  // Fresnel at the face: the transmitted part leaves (tallied), the reflected part goes on.
+  void reflect_at_face(const Vec3& p, Vec3& d, double& w, bool scattered, bool& turned, double* acc) const {
+    double cos_t = 0.0;
+    const double R = fresnel_reflectance(s_.n, 1.0, d.z, &cos_t);
+    const double wt = w * (1.0 - R);
+    if (wt > 0.0) tally_exit(d.z > 0.0, std::acos(std::clamp(cos_t, 0.0, 1.0)), p, wt, scattered, acc);
+    w *= R;
+    d.z = -d.z;
+    turned = turned || d.z <= 0.0;
+  }
+
+  // Interaction: deposit the absorbed fraction, scatter the rest.
+  void interact(Rng& rng, Vec3& d, double& w, bool& scattered, bool& turned, double* acc) const {
+    const double dep = w * s_.sigma_a / sigma_t_;
+    acc[L_.totals() + kAbsorbed] += dep;
+    w -= dep;
+    const double u1 = rng.uniform(), u2 = rng.uniform();
+    d = normalize(phase_sample(s_.phase, d, u1, u2));
+    scattered = true;
+    turned = turned || d.z <= 0.0;
+  }
+
+  // Russian roulette on weight (MCML): survive with probability 0.1 at weight / 0.1. Infinite medium:
+  // depth roulette too, halving the population per transport length beyond the tallies.
+  bool survives_roulette(Rng& rng, const Vec3& p, double& w, int& zone_seen) const {
+    if (w < kRouletteThreshold) {
+      if (rng.uniform() < kRouletteSurvival) w /= kRouletteSurvival;
+      else return false;
+    }
+    if (!slab_) {
+      const double zone = std::max(std::floor((p.z - z_last_) / zone_len_), std::floor(-p.z / zone_len_));
+      while (zone > zone_seen) {
+        ++zone_seen;
+        if (rng.uniform() < 0.5) w *= 2.0;
+        else return false;
+      }
+    }
+    return true;
+  }
+
   // Crossings of the tally planes by the segment p0 -> p1 (direction d).
   void tally_planes(const Vec3& p0, const Vec3& p1, const Vec3& d, double w, bool scattered, bool turned,
                     double* acc) const {
@@ -216,45 +230,62 @@ class Tracer {
 
 }  // namespace
 
+namespace {
+
+// The tallies of each batch: a fixed set of photons (first, count), each photon its own stream.
+struct Batches {
+  std::vector<std::vector<double>> sums;
+  std::vector<uint64_t> counts, first;
+};
+
+Batches trace_batches(const PhotonMcSettings& s, const Layout& L) {
+  const int B = s.batches;
+  Batches out;
+  out.sums.assign(B, std::vector<double>(L.size(), 0.0));
+  out.counts.resize(B);
+  out.first.resize(B);
+  for (int b = 0; b < B; ++b) {
+    out.counts[b] = s.photons / B + (uint64_t(b) < s.photons % B ? 1 : 0);
+    out.first[b] = b == 0 ? 0 : out.first[b - 1] + out.counts[b - 1];
+  }
+  const Tracer tracer(s, L);
+  tbb::parallel_for(tbb::blocked_range<int>(0, B, 1), [&](const tbb::blocked_range<int>& range) {
+    for (int b = range.begin(); b < range.end(); ++b)
+      for (uint64_t i = out.first[b]; i < out.first[b] + out.counts[b]; ++i) {
+        Rng rng(s.seed, i);
+        tracer.trace(rng, out.sums[b].data());
+      }
+  });
+  return out;
+}
+
+// Tally j (times scale): mean over all photons, standard error from the spread of batch means.
+Estimate batch_estimate(const Batches& batches, uint64_t photons, size_t j, double scale) {
+  const int B = int(batches.sums.size());
+  const double N = double(photons);
+  double total = 0.0;
+  for (int b = 0; b < B; ++b) total += batches.sums[b][j];
+  const double mean = total / N;
+  double var = 0.0;
+  for (int b = 0; b < B; ++b) {
+    const double fb = double(batches.counts[b]) / N, xb = batches.sums[b][j] / double(batches.counts[b]);
+    var += fb * fb * (xb - mean) * (xb - mean);
+  }
+  var *= double(B) / double(B - 1);
+  double err = std::sqrt(var);
+  if (err <= 1e-12 * std::abs(mean)) err = 0.0;  // a deterministic tally (the specular part)
+  return Estimate{mean * scale, err * scale};
+}
+
+}  // namespace
+
 PhotonMcResult run_photon_mc(const PhotonMcSettings& s) {
   validate(s);
   const size_t NA = s.theta_edges.size() >= 2 ? s.theta_edges.size() - 1 : 0;
   const size_t NR = s.r_edges.size() >= 2 ? s.r_edges.size() - 1 : 0;
   const Layout L{s.plane_depths.size(), NA, NR};
-  const int B = s.batches;
-  std::vector<std::vector<double>> sums(B, std::vector<double>(L.size(), 0.0));
-  std::vector<uint64_t> counts(B), first(B);
-  for (int b = 0; b < B; ++b) {
-    counts[b] = s.photons / B + (uint64_t(b) < s.photons % B ? 1 : 0);
-    first[b] = b == 0 ? 0 : first[b - 1] + counts[b - 1];
-  }
-  const Tracer tracer(s, L);
-
-  // --- Trace: each batch is a fixed set of photons, each photon its own stream ------------------
-  tbb::parallel_for(tbb::blocked_range<int>(0, B, 1), [&](const tbb::blocked_range<int>& range) {
-    for (int b = range.begin(); b < range.end(); ++b)
-      for (uint64_t i = first[b]; i < first[b] + counts[b]; ++i) {
-        Rng rng(s.seed, i);
-        tracer.trace(rng, sums[b].data());
-      }
-  });
-
-  // --- Estimates: mean over all photons, standard error from the spread of batch means -----------
-  const double N = double(s.photons);
-  auto estimate = [&](size_t j, double scale) {
-    double total = 0.0;
-    for (int b = 0; b < B; ++b) total += sums[b][j];
-    const double mean = total / N;
-    double var = 0.0;
-    for (int b = 0; b < B; ++b) {
-      const double fb = double(counts[b]) / N, xb = sums[b][j] / double(counts[b]);
-      var += fb * fb * (xb - mean) * (xb - mean);
-    }
-    var *= double(B) / double(B - 1);
-    double err = std::sqrt(var);
-    if (err <= 1e-12 * std::abs(mean)) err = 0.0;  // a deterministic tally (the specular part)
-    return Estimate{mean * scale, err * scale};
-  };
+  const Batches batches = trace_batches(s, L);
+  auto estimate = [&](size_t j, double scale) { return batch_estimate(batches, s.photons, j, scale); };
   auto solid_angle = [&](size_t i) { return 2.0 * kPi * (std::cos(s.theta_edges[i]) - std::cos(s.theta_edges[i + 1])); };
   auto area = [&](size_t i) { return kPi * (s.r_edges[i + 1] * s.r_edges[i + 1] - s.r_edges[i] * s.r_edges[i]); };
 

@@ -1,3 +1,4 @@
+// The generalised forward propagator and the phase functions' Legendre moments (small_angle.h).
 #include "transport/small_angle.h"
 
 #include <algorithm>
@@ -112,54 +113,72 @@ double phase_theta2(const Phase& phase) {
 }
 
 // --- ForwardPropagator ---------------------------------------------------------------------------
-ForwardPropagator::ForwardPropagator(const Phase& phase) : chi_(phase_legendre_moments(phase)) {
-  // Z(q), the small-angle (2-D) Fourier transform of the phase function:
-  //  - for q <= kZDirect directly, Z(q) = 2 pi int_0^pi P(theta) J0(q theta) sin(theta) dtheta: the
-  //    transform of a non-negative function (so the spatial density stays non-negative), Z(0) = 1, and
-  //    smooth at q = 0 because deflections are bounded by pi;
-  //  - for large q from the moments by Hilb's asymptotics P_l(cos theta) ~ J0((l + 1/2) theta):
-  //    Z(l + 1/2) = chi_l, Catmull-Rom in l, 0 beyond the last moment;
-  //  - blended smoothly on [kZDirect / 2, kZDirect].
-  const long L = long(chi_.size());
+namespace {
+
+// Z(l + 1/2) = chi_l (Hilb's asymptotics P_l(cos theta) ~ J0((l + 1/2) theta)), Catmull-Rom in l,
+// 0 beyond the last moment.
+double z_hilb(const std::vector<double>& chi_l, double q) {
+  const long L = long(chi_l.size());
   auto chi = [&](long l) {
     const long m = l < 0 ? -1 - l : l;
-    return m < L ? chi_[size_t(m)] : 0.0;
+    return m < L ? chi_l[size_t(m)] : 0.0;
   };
-  auto z_hilb = [&](double q) {
-    const double l = q - 0.5;
-    const long i = long(std::floor(l));
-    const double u = l - double(i);
-    const double c0 = chi(i - 1), c1 = chi(i), c2 = chi(i + 1), c3 = chi(i + 2);
-    return c1 + 0.5 * u * (c2 - c0 + u * (2.0 * c0 - 5.0 * c1 + 4.0 * c2 - c3 + u * (3.0 * (c1 - c2) + c3 - c0)));
-  };
-  // Quadrature in theta: geometric panels from 1e-6 to pi (and a tabulated phase function's nodes).
+  const double l = q - 0.5;
+  const long i = long(std::floor(l));
+  const double u = l - double(i);
+  const double c0 = chi(i - 1), c1 = chi(i), c2 = chi(i + 1), c3 = chi(i + 2);
+  return c1 + 0.5 * u * (c2 - c0 + u * (2.0 * c0 - 5.0 * c1 + 4.0 * c2 - c3 + u * (3.0 * (c1 - c2) + c3 - c0)));
+}
+
+// Quadrature in theta of 2 pi P(theta) sin(theta) dtheta: geometric panels from 1e-6 to pi (and a
+// tabulated phase function's nodes), 4-point Gauss-Legendre in each.
+struct ThetaQuadrature {
+  std::vector<double> nodes, weights;
+  double norm = 0.0;  // the sum of the weights
+};
+
+ThetaQuadrature theta_quadrature(const Phase& phase) {
   std::vector<double> edges{0.0};
   for (double th = 1e-6; th < kPi; th *= 1.02) edges.push_back(th);
   if (const auto* tp = std::get_if<TabulatedPhase>(&phase)) edges.insert(edges.end(), tp->theta.begin(), tp->theta.end());
   edges.push_back(kPi);
   std::sort(edges.begin(), edges.end());
   edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
-  std::vector<double> nodes, weights;
+  ThetaQuadrature quad;
   for (size_t i = 0; i + 1 < edges.size(); ++i) {
     const double h = edges[i + 1] - edges[i];
     for (int q = 0; q < 4; ++q) {
       const double th = edges[i] + h * (0.5 + 0.5 * kGl4x[q]);
-      nodes.push_back(th);
-      weights.push_back(0.5 * h * kGl4w[q] * 2.0 * kPi * phase_eval(phase, std::cos(th)) * std::sin(th));
+      quad.nodes.push_back(th);
+      quad.weights.push_back(0.5 * h * kGl4w[q] * 2.0 * kPi * phase_eval(phase, std::cos(th)) * std::sin(th));
     }
   }
-  double norm = 0.0;
-  for (double w : weights) norm += w;
-  auto z_direct = [&](double q) {
-    double sum = 0.0;
-    for (size_t i = 0; i < nodes.size(); ++i) sum += weights[i] * std::cyl_bessel_j(0.0, q * nodes[i]);
-    return sum / norm;
-  };
+  for (double w : quad.weights) quad.norm += w;
+  return quad;
+}
+
+// Z(q) = 2 pi int_0^pi P(theta) J0(q theta) sin(theta) dtheta, normalised to Z(0) = 1.
+double z_direct(const ThetaQuadrature& quad, double q) {
+  double sum = 0.0;
+  for (size_t i = 0; i < quad.nodes.size(); ++i) sum += quad.weights[i] * std::cyl_bessel_j(0.0, q * quad.nodes[i]);
+  return sum / quad.norm;
+}
+
+}  // namespace
+
+ForwardPropagator::ForwardPropagator(const Phase& phase) : chi_(phase_legendre_moments(phase)) {
+  // Z(q), the small-angle (2-D) Fourier transform of the phase function:
+  //  - for q <= kZDirect directly (z_direct): the transform of a non-negative function (so the spatial
+  //    density stays non-negative), Z(0) = 1, and smooth at q = 0 because deflections are bounded by pi;
+  //  - for large q from the moments by Hilb's asymptotics (z_hilb);
+  //  - blended smoothly on [kZDirect / 2, kZDirect].
+  const long L = long(chi_.size());
+  const ThetaQuadrature quad = theta_quadrature(phase);
   auto Z = [&](double q) {
-    if (q <= 0.5 * kZDirect) return z_direct(q);
-    if (q >= kZDirect) return z_hilb(q);
+    if (q <= 0.5 * kZDirect) return z_direct(quad, q);
+    if (q >= kZDirect) return z_hilb(chi_, q);
     const double u = (q - 0.5 * kZDirect) / (0.5 * kZDirect), w = u * u * (3.0 - 2.0 * u);  // smoothstep
-    return (1.0 - w) * z_direct(q) + w * z_hilb(q);
+    return (1.0 - w) * z_direct(quad, q) + w * z_hilb(chi_, q);
   };
   const size_t nq = size_t((L + 4) / kZStep) + 1;
   // Table: per node (Z, Z', C); cubic Hermite in between, C its exact integral, so R(k) is C^1 in k and

@@ -60,7 +60,7 @@ TEST(VdbOpenVdb, ConversionKeepsTheCloudValues) {
   ASSERT_TRUE(grid);
   EXPECT_EQ(grid->activeVoxelCount(), 415642u);
   EXPECT_EQ(grid->tree().activeTileCount(), 130u);
-  const DensityGrid g = DensityGrid::load(file);
+  const DensityGrid g = load_density_grid(file);
   openvdb::tools::GridSampler<openvdb::FloatGrid, openvdb::tools::BoxSampler> ref(*grid);
   std::mt19937_64 rng(12);
   std::uniform_real_distribution<double> u(0.0, 1.0);
@@ -90,7 +90,7 @@ TEST_P(VdbSynthetic, RoundTripsThroughEveryFormat) {
                                                : nanovdb::io::Codec::NONE;
     nanovdb::io::writeGrid(file.string(), nanovdb::openToNanoVDB(*grid), codec);
   }
-  const DensityGrid g = DensityGrid::load(file);
+  const DensityGrid g = load_density_grid(file);
   EXPECT_EQ(g.stats().name, "density");
   EXPECT_EQ(g.stats().active_voxels, grid->activeVoxelCount());
   EXPECT_EQ(g.stats().tiles, 1u);
@@ -136,8 +136,8 @@ TEST(VdbOpenVdb, GridSelectionAndTypeErrors) {
   temp->setName("temperature");
   temp->tree().setValueOn(openvdb::Coord(0, 0, 0), 300.0f);
   write_vdb(dir / "multi.vdb", {vel, density, temp});
-  EXPECT_EQ(DensityGrid::load(dir / "multi.vdb").stats().name, "density");  // first float grid
-  EXPECT_EQ(DensityGrid::load(dir / "multi.vdb", "temperature").stats().max_value, 300.0);
+  EXPECT_EQ(load_density_grid(dir / "multi.vdb").stats().name, "density");  // first float grid
+  EXPECT_EQ(load_density_grid(dir / "multi.vdb", "temperature").stats().max_value, 300.0);
   std::string msg = test::load_error(dir / "multi.vdb", "smoke");
   EXPECT_NE(msg.find("multi.vdb: no grid named \"smoke\""), std::string::npos) << msg;
   EXPECT_NE(msg.find("\"vel\" (vec3s)"), std::string::npos) << msg;
@@ -153,7 +153,7 @@ TEST(VdbOpenVdb, GridSelectionAndTypeErrors) {
   handles.push_back(nanovdb::openToNanoVDB(*vel));
   handles.push_back(nanovdb::openToNanoVDB(*temp));
   nanovdb::io::writeGrids(dir / "multi.nvdb", handles, nanovdb::io::Codec::BLOSC);
-  EXPECT_EQ(DensityGrid::load(dir / "multi.nvdb").stats().name, "temperature");
+  EXPECT_EQ(load_density_grid(dir / "multi.nvdb").stats().name, "temperature");
   msg = test::load_error(dir / "multi.nvdb", "smoke");
   EXPECT_NE(msg.find("\"vel\" (Vec3f)"), std::string::npos) << msg;
   msg = test::load_error(dir / "multi.nvdb", "vel");
@@ -179,7 +179,7 @@ TEST(VdbOpenVdb, NaNIsAnErrorNegativeIsClampedAndCounted) {
   auto neg = synthetic_grid();
   for (int i = 0; i < 5; ++i) neg->tree().setValueOn(openvdb::Coord(i, 4, 0), -1.0f);
   write_vdb(dir / "neg.vdb", {neg});
-  const DensityGrid g = DensityGrid::load(dir / "neg.vdb");
+  const DensityGrid g = load_density_grid(dir / "neg.vdb");
   EXPECT_EQ(g.stats().negative_count, 5u);
   EXPECT_EQ(g.stats().min_value, -1.0);
   EXPECT_EQ(g.density_index(Vec3(2, 4, 0)), 0.0);
@@ -229,7 +229,7 @@ TEST(VdbOpenVdb, NanoVdbHeadersClaimingATerabyte) {
       b[at] = static_cast<char>(b[at] ^ (1 << (rng() % 8)));
       test::write_bytes(file, b);
       try {
-        const DensityGrid g = DensityGrid::load(file);
+        const DensityGrid g = load_density_grid(file);
         (void)g.density_index(Vec3(1.5, 1.5, 1.5));
       } catch (const Error&) {
       }

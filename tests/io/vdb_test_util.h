@@ -37,7 +37,7 @@ inline void write_bytes(const std::filesystem::path& file, const std::vector<cha
 // Loads `file` expecting a nimbus::Error; returns its message.
 inline std::string load_error(const std::filesystem::path& file, const std::string& grid = "") {
   try {
-    DensityGrid::load(file, grid);
+    load_density_grid(file, grid);
   } catch (const Error& e) {
     return e.what();
   }

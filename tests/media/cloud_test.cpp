@@ -2,7 +2,7 @@
 #include <gtest/gtest.h>
 
 #include "io/scene_volumes.h"
-#include "io/vdb.h"
+#include "media/density_grid.h"
 #include "media/cloud.h"
 
 namespace nimbus {
