@@ -35,6 +35,7 @@
 #include <memory>
 #include <vector>
 
+#include "integrators/beam_grid.h"
 #include "integrators/integrator.h"
 #include "integrators/scatter_grid.h"
 #include "integrators/shadow_map.h"
