@@ -178,19 +178,19 @@ BeamGrid::BeamGrid(const SceneContext& ctx, const std::vector<const PhaseSplit*>
     const auto* dir = std::get_if<DirectionalLight>(&light);
     const auto* point = std::get_if<PointLight>(&light);
     if (!dir && !point) continue;
-    const BeamPhotons beam{ctx,
-                           splits,
-                           peak_fraction,
-                           reduced_maps[l],
-                           grid_,
-                           l,
-                           point,
-                           dir ? dir->irradiance : point->intensity,
-                           dir ? normalize(dir->direction) : Vec3(0.0),
-                           grey,
-                           per_light,
-                           centre,
-                           radius};
+    const BeamPhotons beam{.ctx = ctx,
+                           .splits = splits,
+                           .peak_fraction = peak_fraction,
+                           .T_wide = reduced_maps[l],
+                           .grid = grid_,
+                           .light = l,
+                           .point = point,
+                           .strength = dir ? dir->irradiance : point->intensity,
+                           .dir_w = dir ? normalize(dir->direction) : Vec3(0.0),
+                           .grey = grey,
+                           .per_light = per_light,
+                           .centre = centre,
+                           .radius = radius};
     // The batches' sums divided by the node volume.
     values_[l] = trace_photons(
         total, seed ^ 0x7065616b6265616dull ^ (uint64_t(l) << 40), grid_.size() * kFloats,

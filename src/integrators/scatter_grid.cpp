@@ -201,11 +201,19 @@ void ScatterGrid::trace(const SceneContext& ctx, const std::vector<const PhaseSp
   const Bounds media_bounds = ctx.media.bounds();
   const Vec3 extent = media_bounds.hi - media_bounds.lo;
   const ScatterPhotons photons{
-      ctx,     splits,      peak_fraction,
-      s,       grid_,       bands_,
-      grey,    lights,      sources,
-      per_source, (media_bounds.lo + media_bounds.hi) * 0.5, 0.5 * extent.length() * (1.0 + 1e-9) + 1e-12,
-      s.max_wide_scatters <= 0 ? kMaxWideScatters : std::min(s.max_wide_scatters, kMaxWideScatters)};
+      .ctx = ctx,
+      .splits = splits,
+      .peak_fraction = peak_fraction,
+      .s = s,
+      .grid = grid_,
+      .bands = bands_,
+      .grey = grey,
+      .lights = lights,
+      .sources = sources,
+      .per_source = per_source,
+      .centre = (media_bounds.lo + media_bounds.hi) * 0.5,
+      .radius = 0.5 * extent.length() * (1.0 + 1e-9) + 1e-12,
+      .K = s.max_wide_scatters <= 0 ? kMaxWideScatters : std::min(s.max_wide_scatters, kMaxWideScatters)};
   // The batches' sums divided by the node volume: fluence and flux.
   values_ = trace_photons(
       total, s.seed ^ 0x6d756c7469706c65ull, values_.size(), 1.0 / grid_.cell_volume(),
