@@ -61,6 +61,7 @@
 #include <optional>
 #include <vector>
 
+#include "integrators/beam_grid.h"
 #include "integrators/integrator.h"
 #include "integrators/scatter_grid.h"
 #include "integrators/shadow_map.h"

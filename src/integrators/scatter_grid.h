@@ -21,12 +21,15 @@
 //
 // Deterministic: photon i uses its own random stream; photons are split into a fixed number of
 // batches (each its own grid, summed in order), so the grid does not depend on the thread count.
+// The photons are traced by the shared photon tracer (integrators/photon_tracer.h); the node layout
+// and its trilinear lookup are core/node_grid.h's.
 #pragma once
 
 #include <array>
 #include <cstdint>
 #include <vector>
 
+#include "core/node_grid.h"
 #include "core/sh.h"
 #include "integrators/integrator.h"
 #include "transport/phase_split.h"
@@ -60,6 +63,10 @@ class ScatterGrid {
                          double spread) const;
   int bands() const { return bands_; }
 
+  // Similarity transport only: wide scatters whose direction the rejection sampler could not draw (the
+  // photon flew on undeflected; see sample_by_rejection). 0 in every normal case.
+  uint64_t rejection_failures() const { return rejection_failures_; }
+
   size_t memory_bytes() const {
     size_t bytes = values_.size() * sizeof(float);
     for (const auto& m : mips_) bytes += m.values.size() * sizeof(float);
@@ -67,59 +74,23 @@ class ScatterGrid {
   }
 
  private:
-  Bounds bounds_;  // of the node grid (the media's bounds padded by one spacing)
-  std::array<int, 3> nodes_{2, 2, 2};
-  Vec3 spacing_{1.0};
+  NodeGrid grid_;  // the media's bounds padded by one spacing (node_grid_padded)
   int bands_ = 3, coeffs_ = 9;
+  uint64_t rejection_failures_ = 0;
   std::vector<float> values_;  // per node: channel c at [coeffs c + h]: L_lm, h = l^2 + l + m
   struct Level {
-    std::array<int, 3> nodes;
-    Vec3 spacing;
+    NodeGrid grid;  // nodes at grid_.bounds.lo + j spacing (may overhang grid_.bounds)
     std::vector<float> values;
   };
-  std::vector<Level> mips_;  // levels 1, 2, ...: nodes at bounds_.lo + j spacing (may overhang bounds_)
+  std::vector<Level> mips_;  // levels 1, 2, ...
   // The moments at p of level k (0: values_), summed into L with weight wt.
   void accumulate(int level, const Vec3& p, double wt, double* L) const;
   // sum_lm chi_l L_lm Y_lm(w_out) per channel from moments L (as values_ lays out a node), clamped at 0.
   Rgb evaluate(const double* L, const Vec3& w_out, const std::array<Rgb, kShMaxBands>& chi) const;
+  // The photons of the constructor (settings s) into values_.
+  void trace(const SceneContext& ctx, const std::vector<const PhaseSplit*>& splits,
+             const std::vector<double>& peak_fraction, const ScatterGridSettings& s);
   void build_mips();
-};
-
-class TransmittanceGrid;
-
-// The lights' peak-only beams (light that has not yet scattered widely) as they really travel, against
-// the straight-line picture `mfs` uses for them: from the light's entry, T_wide = exp(-int (sigma_a +
-// (1 - f) sigma_s)) along the straight line (the reduced shadow map), as if every peak scatter kept the
-// light on its line. Peak scatters deflect it: its paths are longer (more absorption and wide
-// scattering on the way, the corrected kernel's 1 / cosh loss), and near a medium's sides it spreads out
-// of the medium and into its shadow. Per light and node:
-//     R(x) = phi_peak(x) / (phi_0(x) T_wide(x)),
-// phi_peak the fluence of the peak-only light, estimated by photons traced through the true medium:
-// flights end at peak scatters only (rate sum_m f_m sigma_s,m; the new direction from P_peak), while
-// absorption and wide scatters are a continuous loss exp(-int sigma_loss) on the photon's weight, so in
-// a uniform medium a photon's weight depends only on its path length. Track-length deposits are each
-// divided by the model phi_0 T_wide at the deposit point (phi_0: the unattenuated fluence, the
-// irradiance or I / r^2), and the same photon is deposited once more undeflected (the model itself, with
-// the same emission: a control variate), so R = traced / straight is 1 wherever nothing deflects the
-// light. Photons enter through a stratified disc or cone (the R2 sequence). The traced deposits also
-// carry the cosine to the straight direction from the light: the beam's mean cosine, which sets the
-// angular spread `mfs` gives the peak-only light. `mfs` multiplies T_wide by R.
-class BeamGrid {
- public:
-  // reduced_maps[l]: light l's T_wide; photons: per light; resolution as ScatterGridSettings.
-  BeamGrid(const SceneContext& ctx, const std::vector<const PhaseSplit*>& splits,
-           const std::vector<double>& peak_fraction, const std::vector<TransmittanceGrid>& reduced_maps,
-           int photons, int resolution, uint64_t seed);
-  // R for light `light` at p (trilinear between nodes) and the peak-only light's mean cosine to the
-  // straight direction from the light; false (nothing written) outside the grid and for other lights.
-  bool lookup(size_t light, const Vec3& p, Rgb* factor, Rgb* mean_cosine) const;
-  size_t memory_bytes() const;
-
- private:
-  Bounds bounds_;
-  std::array<int, 3> nodes_{2, 2, 2};
-  Vec3 spacing_{1.0};
-  std::vector<std::vector<float>> values_;  // per light and node: traced, traced x cosine, straight (rgb)
 };
 
 }  // namespace nimbus

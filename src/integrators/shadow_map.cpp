@@ -1,8 +1,8 @@
+// The shadow maps (integrators/shadow_map.h): reduced extinction, marched transmittance, the node grid.
 #include "integrators/shadow_map.h"
 
 #include <tbb/parallel_for.h>
 
-#include "core/trilinear.h"
 #include "integrators/tracking.h"
 #include "scene/lights.h"
 
@@ -30,22 +30,17 @@ Rgb marched_transmittance(const SceneMedia& media, const MajorantGrid& grid, con
 TransmittanceGrid::TransmittanceGrid(const SceneMedia& media, const MajorantGrid& grid, const Light& light,
                                      int resolution, double tau_step,
                                      const std::vector<double>& peak_fraction) {
-  bounds_ = grid.bounds();
-  if (bounds_.empty()) {
-    bounds_.lo = Vec3(0.0);
-    bounds_.hi = Vec3(1.0);
+  Bounds bounds = grid.bounds();
+  if (bounds.empty()) {
+    bounds.lo = Vec3(0.0);
+    bounds.hi = Vec3(1.0);
   }
-  const Vec3 extent = bounds_.hi - bounds_.lo;
-  const double longest = std::max({extent.x, extent.y, extent.z});
-  for (int a = 0; a < 3; ++a) {
-    nodes_[a] = std::max(2, int(std::ceil(extent[a] / longest * (resolution - 1))) + 1);
-    spacing_[a] = extent[a] / (nodes_[a] - 1);
-  }
-  values_.assign(size_t(nodes_[0]) * nodes_[1] * nodes_[2] * 3, 1.0f);
-  tbb::parallel_for(0, nodes_[2], [&](int z) {
-    for (int y = 0; y < nodes_[1]; ++y) {
-      for (int x = 0; x < nodes_[0]; ++x) {
-        const Vec3 p = bounds_.lo + Vec3(x, y, z) * spacing_;
+  grid_ = node_grid_spanning(bounds, resolution);
+  values_.assign(grid_.size() * 3, 1.0f);
+  tbb::parallel_for(0, grid_.nodes[2], [&](int z) {
+    for (int y = 0; y < grid_.nodes[1]; ++y) {
+      for (int x = 0; x < grid_.nodes[0]; ++x) {
+        const Vec3 p = grid_.position(x, y, z);
         LightSample ls;
         Rgb T(1.0);
         // The centre of the light (a sun disc is treated as its centre direction here).
@@ -55,7 +50,7 @@ TransmittanceGrid::TransmittanceGrid(const SceneMedia& media, const MajorantGrid
         } else if (sample_light(light, p, 0.5, 0.5, &ls)) {
           T = marched_transmittance(media, grid, p, ls.wi, ls.distance, tau_step, peak_fraction);
         }
-        float* v = &values_[((size_t(z) * nodes_[1] + y) * nodes_[0] + x) * 3];
+        float* v = &values_[grid_.index(x, y, z) * 3];
         for (int c = 0; c < 3; ++c) v[c] = float(T[c]);
       }
     }
@@ -63,7 +58,7 @@ TransmittanceGrid::TransmittanceGrid(const SceneMedia& media, const MajorantGrid
 }
 
 Rgb TransmittanceGrid::lookup(const Vec3& p) const {
-  const TrilinearStencil st = trilinear_stencil(p, bounds_.lo, spacing_, nodes_);
+  const TrilinearStencil st = grid_.stencil(p);
   Rgb r(0.0);
   for (int k = 0; k < 8; ++k) {
     const float* v = &values_[st.node[k] * 3];

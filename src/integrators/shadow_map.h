@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "core/math.h"
+#include "core/node_grid.h"
 #include "media/majorant.h"
 #include "media/media.h"
 #include "nimbus/scene.h"
@@ -33,9 +34,7 @@ class TransmittanceGrid {
   size_t memory_bytes() const { return values_.size() * sizeof(float); }
 
  private:
-  Bounds bounds_;
-  std::array<int, 3> nodes_{2, 2, 2};
-  Vec3 spacing_{1.0};
+  NodeGrid grid_;              // nodes on the media's bounds (node_grid_spanning)
   std::vector<float> values_;  // rgb per node
 };
 

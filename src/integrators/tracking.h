@@ -1,11 +1,14 @@
 // The one tracking kernel (after pbrt-v4's SampleT_maj): tentative collisions distributed with the
 // majorant density, cell by cell of the majorant grid. Delta tracking (pathtrace), ratio tracking
-// (transmittance) and the other integrators all build on it.
+// (transmittance) and the other integrators all build on it. Debug builds check its invariants
+// (NIMBUS_DCHECK: majorants finite and non-negative, extinction in [0, majorant], weights finite and
+// non-negative); Release builds compile the checks away.
 #pragma once
 
 #include <algorithm>
 #include <cmath>
 
+#include "core/check.h"
 #include "core/rng.h"
 #include "media/majorant.h"
 #include "media/media.h"
@@ -19,6 +22,7 @@ template <typename F>
 bool track(const MajorantGrid& grid, const Vec3& o, const Vec3& d, double tmax, Rng& rng, F&& on_collision) {
   bool reached_end = true;
   grid.traverse(o, d, 0.0, tmax, [&](double t0, double t1, double maj) {
+    NIMBUS_DCHECK(maj >= 0.0 && std::isfinite(maj));
     if (maj <= 0.0) return true;
     double t = t0;
     while (true) {
@@ -79,7 +83,11 @@ Rgb ratio_tracking(const MajorantGrid& grid, const Vec3& o, const Vec3& d, doubl
                    Sigma&& sigma) {
   Rgb T(1.0);
   track(grid, o, d, tmax, rng, [&](const Vec3& p, double maj) {
-    T *= Rgb(1.0) - sigma(p) / maj;
+    const Rgb sigma_t = sigma(p);
+    // The null-collision share 1 - sigma_t / maj of each channel is in [0, 1].
+    NIMBUS_DCHECK(min_component(sigma_t) >= 0.0 && max_component(sigma_t) <= maj);
+    T *= Rgb(1.0) - sigma_t / maj;
+    NIMBUS_DCHECK(min_component(T) >= 0.0 && std::isfinite(max_component(T)));
     const double m = max_component(T);
     if (m <= 0.0) {
       T = Rgb(0.0);

@@ -1,0 +1,50 @@
+// The lights' peak-only beams (light that has not yet scattered widely) as they really travel, against
+// the straight-line picture `mfs` uses for them: from the light's entry, T_wide = exp(-int (sigma_a +
+// (1 - f) sigma_s)) along the straight line (the reduced shadow map), as if every peak scatter kept the
+// light on its line. Peak scatters deflect it: its paths are longer (more absorption and wide
+// scattering on the way, the corrected kernel's 1 / cosh loss), and near a medium's sides it spreads out
+// of the medium and into its shadow. Per light and node:
+//     R(x) = phi_peak(x) / (phi_0(x) T_wide(x)),
+// phi_peak the fluence of the peak-only light, estimated by photons traced through the true medium:
+// flights end at peak scatters only (rate sum_m f_m sigma_s,m; the new direction from P_peak), while
+// absorption and wide scatters are a continuous loss exp(-int sigma_loss) on the photon's weight, so in
+// a uniform medium a photon's weight depends only on its path length. Track-length deposits are each
+// divided by the model phi_0 T_wide at the deposit point (phi_0: the unattenuated fluence, the
+// irradiance or I / r^2), and the same photon is deposited once more undeflected (the model itself, with
+// the same emission: a control variate), so R = traced / straight is 1 wherever nothing deflects the
+// light. Photons enter through a stratified disc or cone (the R2 sequence). The traced deposits also
+// carry the cosine to the straight direction from the light: the beam's mean cosine, which sets the
+// angular spread `mfs` gives the peak-only light. `mfs` multiplies T_wide by R.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "core/node_grid.h"
+#include "integrators/integrator.h"
+#include "integrators/shadow_map.h"
+#include "transport/phase_split.h"
+
+namespace nimbus {
+
+class BeamGrid {
+ public:
+  // reduced_maps[l]: light l's T_wide; photons: per light; resolution as ScatterGridSettings.
+  BeamGrid(const SceneContext& ctx, const std::vector<const PhaseSplit*>& splits,
+           const std::vector<double>& peak_fraction, const std::vector<TransmittanceGrid>& reduced_maps,
+           int photons, int resolution, uint64_t seed);
+  // R for light `light` at p (trilinear between nodes) and the peak-only light's mean cosine to the
+  // straight direction from the light; false (nothing written) outside the grid and for other lights.
+  bool lookup(size_t light, const Vec3& p, Rgb* factor, Rgb* mean_cosine) const;
+  size_t memory_bytes() const;
+  // Peak scatters whose direction the rejection sampler could not draw (the photon flew on
+  // undeflected; see sample_by_rejection). 0 in every normal case.
+  uint64_t rejection_failures() const { return rejection_failures_; }
+
+ private:
+  NodeGrid grid_;  // the media's bounds padded by one spacing (node_grid_padded)
+  std::vector<std::vector<float>> values_;  // per light and node: traced, traced x cosine, straight (rgb)
+  uint64_t rejection_failures_ = 0;
+};
+
+}  // namespace nimbus

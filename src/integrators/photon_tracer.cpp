@@ -1,0 +1,87 @@
+// The photon tracer's emission and batching (integrators/photon_tracer.h).
+#include "integrators/photon_tracer.h"
+
+#include <tbb/parallel_for.h>
+
+#include <cmath>
+
+namespace nimbus {
+
+Photon emit(const SceneContext& ctx, size_t source, const Vec3& c, double r, double n, Rng& rng,
+            const double* strat) {
+  double u1 = rng.uniform(), u2 = rng.uniform(), u3 = rng.uniform(), u4 = rng.uniform();
+  if (strat) u1 = u3 = strat[0], u2 = u4 = strat[1];
+  const double disc_area = kPi * r * r;
+  auto through_disc = [&](const Vec3& w) {
+    const Frame frame(w);
+    const double rr = r * std::sqrt(u3), phi = 2.0 * kPi * u4;
+    return c - w * (2.0 * r) + frame.to_world({rr * std::cos(phi), rr * std::sin(phi), 0.0});
+  };
+  Photon p;
+  if (source < ctx.lights.size()) {
+    const Light& light = ctx.lights[source];
+    if (const auto* d = std::get_if<DirectionalLight>(&light)) {
+      p.w = normalize(d->direction);
+      p.x = through_disc(p.w);
+      p.power = d->irradiance * (disc_area / n);
+    } else if (const auto* pt = std::get_if<PointLight>(&light)) {
+      const Vec3 v = c - pt->position;
+      const double dist = v.length();
+      p.x = pt->position;
+      if (dist > r) {
+        const double cos_max = std::sqrt(std::max(0.0, 1.0 - r * r / (dist * dist)));
+        p.w = spherical_direction(1.0 - u1 * (1.0 - cos_max), 2.0 * kPi * u2, v / dist);
+        p.power = pt->intensity * (2.0 * kPi * (1.0 - cos_max) / n);
+      } else {
+        p.w = spherical_direction(1.0 - 2.0 * u1, 2.0 * kPi * u2, Vec3(0, 0, 1));
+        p.power = pt->intensity * (4.0 * kPi / n);
+      }
+    }
+  } else {
+    // Uniform radiance L from every direction: flux L 4 pi A through a disc of area A.
+    p.w = spherical_direction(1.0 - 2.0 * u1, 2.0 * kPi * u2, Vec3(0, 0, 1));
+    p.x = through_disc(p.w);
+    p.power = ctx.environment * (4.0 * kPi * disc_area / n);
+  }
+  return p;
+}
+
+bool grey_media(const SceneContext& ctx) {
+  bool grey = true;
+  for (int i = 0; i < ctx.media.count(); ++i) {
+    const Medium& m = ctx.media.medium(i);
+    grey = grey && m.sigma_s.x == m.sigma_s.y && m.sigma_s.y == m.sigma_s.z && m.sigma_a.x == m.sigma_a.y &&
+           m.sigma_a.y == m.sigma_a.z;
+  }
+  return grey;
+}
+
+std::vector<float> trace_photons(size_t total, uint64_t stream_seed, size_t tally_size, double scale,
+                                 const TracePhoton& trace_photon, uint64_t* rejection_failures) {
+  std::vector<PhotonBatch> batch(kPhotonBatches);
+  std::vector<double> batch_scale(kPhotonBatches, 1.0);
+  tbb::parallel_for(0, kPhotonBatches, [&](int b) {
+    PhotonBatch& pb = batch[b];
+    pb.tally.assign(tally_size, 0.0f);
+    const size_t begin = total * size_t(b) / kPhotonBatches, end = total * size_t(b + 1) / kPhotonBatches;
+    const double budget = kEventsPerPhoton * double(end - begin);
+    size_t j = begin;
+    for (; j < end && pb.collisions <= budget; ++j) {
+      Rng rng(stream_seed, j);
+      trace_photon(j, rng, pb);
+    }
+    batch_scale[b] = j > begin ? double(end - begin) / double(j - begin) : 1.0;
+  });
+
+  // Sum the batches in order (the same sum for every thread count).
+  std::vector<float> sum(tally_size);
+  tbb::parallel_for(size_t(0), tally_size, [&](size_t n) {
+    double s = 0.0;
+    for (int b = 0; b < kPhotonBatches; ++b) s += batch_scale[b] * batch[b].tally[n];
+    sum[n] = float(s * scale);
+  });
+  for (const PhotonBatch& pb : batch) *rejection_failures += pb.rejection_failures;
+  return sum;
+}
+
+}  // namespace nimbus

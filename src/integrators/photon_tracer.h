@@ -1,0 +1,138 @@
+// The one photon tracer behind the grids `mfs` fills before it renders (the scatter grid and the beam
+// grid): emission from the lights and the environment, a fixed number of batches (so the grids do not
+// depend on the thread count), the work budget, and the walker. The walker is written once, after the
+// tracking kernel (integrators/tracking.h): it flies a photon from collision to collision (delta
+// tracking against the majorant grid with the caller's density of real collisions) and calls back per
+// flight (to deposit it) and per real collision (to weight, end or turn the photon). What a collision
+// is, what a flight deposits and how a photon turns belong to the grids.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <functional>
+#include <limits>
+#include <vector>
+
+#include "core/check.h"
+#include "core/math.h"
+#include "core/rng.h"
+#include "integrators/integrator.h"
+#include "integrators/tracking.h"
+#include "media/media.h"
+
+namespace nimbus {
+
+inline constexpr int kPhotonBatches = 8;  // fixed: the grids must not depend on the thread count
+inline constexpr int kMaxPhotonEvents = 1 << 14;  // photons are ended after this many real collisions
+// Work budget: a batch stops starting photons once its collisions exceed this many per photon of the
+// batch, and its deposits are scaled by planned / traced photons (optically very thick media would
+// otherwise take hours; below the budget nothing changes).
+inline constexpr double kEventsPerPhoton = 512.0;
+// Tries of a rejection-sampled scatter direction (sample_by_rejection) before it gives up.
+inline constexpr int kMaxRejectionTries = 10000;
+
+struct Photon {
+  Vec3 x, w;
+  Rgb power;
+};
+
+// A photon leaving the light `source` (lights first, then the environment) towards the media's
+// bounding sphere (centre c, radius r); power per photon for n photons of that source.
+// strat: if given, the 2-D sample that places the photon (the disc point, or a point light's direction).
+// Always consumes 4 uniform numbers.
+Photon emit(const SceneContext& ctx, size_t source, const Vec3& c, double r, double n, Rng& rng,
+            const double* strat = nullptr);
+
+// True when every medium's sigma_s and sigma_a are equal in all channels (one photon pass carries RGB).
+bool grey_media(const SceneContext& ctx);
+
+// What one batch of photons has written and spent.
+struct PhotonBatch {
+  std::vector<float> tally;           // the grid's per-node sums, laid out as the grid wants
+  double collisions = 0.0;            // real collisions so far (the work budget's measure)
+  uint64_t rejection_failures = 0;    // scatters whose direction sample_by_rejection could not draw
+};
+
+// Traces photons j = 0 .. total - 1, each with its own stream Rng(stream_seed, j), by
+// trace_photon(j, rng, batch), in kPhotonBatches fixed batches run in parallel. A batch stops starting
+// photons once its collisions exceed kEventsPerPhoton per planned photon and scales its tally by
+// planned / traced photons. Returns the batches' tallies summed in order, times `scale`, and adds
+// their rejection failures to *rejection_failures.
+using TracePhoton = std::function<void(size_t j, Rng& rng, PhotonBatch& batch)>;
+std::vector<float> trace_photons(size_t total, uint64_t stream_seed, size_t tally_size, double scale,
+                                 const TracePhoton& trace_photon, uint64_t* rejection_failures);
+
+// Flies a photon from x along w: delta tracking with real collisions at density sigma(p) (<= the
+// majorant); on_flight(x, w, t_end) for each flight (t_end infinite when the photon leaves the media),
+// then on_collision(xc, &w) -> bool at each real collision xc (false ends the photon; it may turn w).
+// At most kMaxPhotonEvents collisions; each one that does not end the photon adds 1 to *collisions.
+template <typename Sigma, typename OnFlight, typename OnCollision>
+void walk_photon(const MajorantGrid& majorants, Vec3 x, Vec3 w, Rng& rng, double* collisions, Sigma&& sigma,
+                 OnFlight&& on_flight, OnCollision&& on_collision) {
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  for (int events = 0; events < kMaxPhotonEvents; ++events, *collisions += 1.0) {
+    bool hit = false;
+    Vec3 xc;
+    track(majorants, x, w, kInf, rng, [&](const Vec3& p, double maj) {
+      const double s = sigma(p);
+      NIMBUS_DCHECK(s >= 0.0 && s <= maj);  // a real collision's probability s / maj in [0, 1]
+      if (rng.uniform() * maj < s) {
+        hit = true;
+        xc = p;
+        return false;
+      }
+      return true;
+    });
+    on_flight(x, w, hit ? (xc - x).length() : kInf);
+    if (!hit || !on_collision(xc, &w)) return;
+    NIMBUS_DCHECK(std::abs(w.length() - 1.0) < 1e-6);
+    x = xc;
+  }
+}
+
+// The media's shares of the scattering at a collision: part[i] = share(i) sigma_s_i[c].
+struct ScatteringShares {
+  double part[kMaxMedia];
+  double sum = 0.0;
+  int count = 0;  // mp.count
+};
+template <typename Share>
+ScatteringShares scattering_shares(const MediumPoint& mp, int media_count, int c, Share&& share) {
+  NIMBUS_DCHECK(mp.count <= media_count);
+  ScatteringShares s;
+  s.count = mp.count;
+  for (int i = 0; i < mp.count && i < media_count; ++i) {
+    s.part[i] = share(i) * mp.sigma_s_i[i][c];
+    NIMBUS_DCHECK(s.part[i] >= 0.0);
+    s.sum += s.part[i];
+  }
+  return s;
+}
+
+// Medium m with probability part[m] / sum (one uniform number); sum > 0.
+inline int choose_medium(const ScatteringShares& s, Rng& rng) {
+  NIMBUS_DCHECK(s.sum > 0.0);
+  double u = rng.uniform() * s.sum;
+  int m = 0;
+  while (m + 1 < s.count && u >= s.part[m]) u -= s.part[m++];
+  return m;
+}
+
+// A direction by rejection: candidates from draw() until accept(candidate) (which draws its own
+// uniform number), at most kMaxRejectionTries; the accepted one is written to *w. Expected tries are
+// 1 / (accepted share), at most 100 for the shares `mfs` allows (peak_fraction <= 0.99). When every try
+// fails, *w is left as it was — the photon flies on undeflected, as if it had not scattered — and the
+// result is false, so the caller can count it (PhotonBatch::rejection_failures).
+template <typename Draw, typename Accept>
+bool sample_by_rejection(Vec3* w, Draw&& draw, Accept&& accept) {
+  for (int tries = 0; tries < kMaxRejectionTries; ++tries) {
+    const Vec3 candidate = draw();
+    if (accept(candidate)) {
+      *w = candidate;
+      return true;
+    }
+  }
+  return false;
+}
+
+}  // namespace nimbus

@@ -1,0 +1,102 @@
+// The node grid shared by the scatter grid, the beam grid and the shadow maps: its two layouts, its
+// indexing and its trilinear lookup (exact for linear functions, weights summing to 1, clamping).
+#include <gtest/gtest.h>
+
+#include <vector>
+
+#include "core/check.h"
+#include "core/node_grid.h"
+#include "core/rng.h"
+
+namespace nimbus {
+namespace {
+
+double linear(const Vec3& p) { return 0.7 - 1.3 * p.x + 2.1 * p.y + 0.4 * p.z; }
+
+// Values of f at the nodes of g, interpolated at p by g's stencil.
+double interpolate(const NodeGrid& g, const std::vector<double>& values, const Vec3& p) {
+  const TrilinearStencil st = g.stencil(p);
+  double v = 0.0;
+  for (int k = 0; k < 8; ++k) v += st.weight[k] * values[st.node[k]];
+  return v;
+}
+
+template <typename F>
+std::vector<double> sample_nodes(const NodeGrid& g, F&& f) {
+  std::vector<double> values(g.size());
+  for (int z = 0; z < g.nodes[2]; ++z)
+    for (int y = 0; y < g.nodes[1]; ++y)
+      for (int x = 0; x < g.nodes[0]; ++x) values[g.index(x, y, z)] = f(g.position(x, y, z));
+  return values;
+}
+
+TEST(NodeGrid, SpanningLayoutPutsNodesOnTheBoxFaces) {
+  const Bounds b{Vec3(-1.0, 0.0, 2.0), Vec3(3.0, 1.0, 2.5)};
+  const NodeGrid g = node_grid_spanning(b, 9);
+  EXPECT_EQ(g.nodes[0], 9);  // the longest axis
+  EXPECT_EQ(g.nodes[1], 3);  // ceil(1/4 * 8) + 1
+  EXPECT_EQ(g.nodes[2], 2);  // ceil(0.5/4 * 8) + 1
+  for (int a = 0; a < 3; ++a) {
+    EXPECT_DOUBLE_EQ(g.position(0, 0, 0)[a], b.lo[a]);
+    EXPECT_NEAR(g.position(g.nodes[0] - 1, g.nodes[1] - 1, g.nodes[2] - 1)[a], b.hi[a], 1e-12);
+  }
+  EXPECT_EQ(g.size(), size_t(9 * 3 * 2));
+  EXPECT_EQ(g.index(g.nodes[0] - 1, g.nodes[1] - 1, g.nodes[2] - 1), g.size() - 1);
+}
+
+TEST(NodeGrid, PaddedLayoutCoversTheMediaWithOneSpacingToSpare) {
+  const Bounds media{Vec3(0.0, 0.0, 0.0), Vec3(2.0, 1.0, 0.0)};  // flat in z
+  const NodeGrid g = node_grid_padded(media, 5);
+  EXPECT_EQ(g.nodes[0], 5 + 2);
+  for (int a = 0; a < 3; ++a) {
+    EXPECT_GT(g.spacing[a], 0.0);
+    EXPECT_NEAR(g.bounds.lo[a], media.lo[a] - g.spacing[a], 1e-15);
+    EXPECT_NEAR(g.bounds.hi[a], g.bounds.lo[a] + g.spacing[a] * (g.nodes[a] - 1), 1e-15);
+    EXPECT_GE(g.bounds.hi[a], media.hi[a] + g.spacing[a] * (1.0 - 1e-9));
+  }
+  EXPECT_DOUBLE_EQ(g.min_spacing(), g.spacing.z);
+  EXPECT_DOUBLE_EQ(g.cell_volume(), g.spacing.x * g.spacing.y * g.spacing.z);
+}
+
+TEST(NodeGrid, TrilinearWeightsSumToOneAndReproduceLinearFunctions) {
+  const NodeGrid g = node_grid_padded(Bounds{Vec3(-1.0, 0.5, 2.0), Vec3(2.0, 1.5, 4.0)}, 7);
+  const std::vector<double> values = sample_nodes(g, linear);
+  Rng rng(3, 4);
+  for (int i = 0; i < 1000; ++i) {
+    Vec3 p;
+    for (int a = 0; a < 3; ++a) p[a] = g.bounds.lo[a] + rng.uniform() * (g.bounds.hi[a] - g.bounds.lo[a]);
+    const TrilinearStencil st = g.stencil(p);
+    double sum = 0.0;
+    for (int k = 0; k < 8; ++k) {
+      EXPECT_GE(st.weight[k], 0.0);
+      EXPECT_LT(st.node[k], g.size());
+      sum += st.weight[k];
+    }
+    EXPECT_NEAR(sum, 1.0, 1e-12);
+    EXPECT_NEAR(interpolate(g, values, p), linear(p), 1e-12) << p;
+  }
+  // At a node the lookup returns that node's value.
+  EXPECT_NEAR(interpolate(g, values, g.position(3, 2, 1)), values[g.index(3, 2, 1)], 1e-12);
+}
+
+TEST(NodeGrid, PointsOutsideAreClampedToTheNearestBoundary) {
+  const NodeGrid g = node_grid_spanning(Bounds{Vec3(0.0), Vec3(1.0)}, 4);
+  const std::vector<double> values = sample_nodes(g, linear);
+  const Vec3 outside(-5.0, 0.5, 7.0), clamped(0.0, 0.5, 1.0);
+  EXPECT_NEAR(interpolate(g, values, outside), linear(clamped), 1e-12);
+}
+
+TEST(Check, DcheckIsCompiledAwayInReleaseBuilds) {
+  int evaluated = 0;
+  NIMBUS_DCHECK(++evaluated > 0);
+  EXPECT_EQ(evaluated, NIMBUS_DEBUG_CHECKS ? 1 : 0);
+}
+
+#if NIMBUS_DEBUG_CHECKS
+TEST(CheckDeathTest, FailedDcheckNamesTheConditionAndAborts) {
+  EXPECT_DEATH(NIMBUS_DCHECK(1 + 1 == 3), "NIMBUS_DCHECK\\(1 \\+ 1 == 3\\) failed");
+}
+#endif
+
+}  // namespace
+}  // namespace nimbus

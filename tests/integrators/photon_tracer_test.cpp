@@ -1,0 +1,77 @@
+// The shared photon tracer of the scatter and beam grids: the batches and the work budget, the
+// rejection sampler's explicit failure, and no failures in the grids `mfs` builds for a usual scene.
+#include <gtest/gtest.h>
+
+#include <atomic>
+
+#include "integrators/mfs.h"
+#include "integrators/photon_tracer.h"
+#include "support/scenes.h"
+
+namespace nimbus {
+namespace {
+
+TEST(PhotonTracer, BatchesSumEveryPhotonOnce) {
+  const size_t total = 1003;  // not a multiple of the batch count
+  uint64_t failures = 0;
+  const std::vector<float> sum = trace_photons(
+      total, 42, 2, 0.5,
+      [](size_t j, Rng& rng, PhotonBatch& batch) {
+        batch.tally[0] += 1.0f;
+        batch.tally[1] += float(j);
+        batch.rejection_failures += j % 2;
+      },
+      &failures);
+  EXPECT_FLOAT_EQ(sum[0], 0.5f * total);
+  EXPECT_FLOAT_EQ(sum[1], 0.5f * total * (total - 1) / 2);
+  EXPECT_EQ(failures, total / 2);
+}
+
+TEST(PhotonTracer, WorkBudgetScalesTheTracedPhotonsToThePlannedOnes) {
+  const size_t total = kPhotonBatches * 10;
+  std::atomic<size_t> traced{0};
+  uint64_t failures = 0;
+  // Each photon costs 4 times the budget's share: a batch of 10 stops after 3 photons (4 x 512 x 3 >
+  // 512 x 10) and scales its tally by 10 / 3.
+  const std::vector<float> sum = trace_photons(
+      total, 1, 1, 1.0,
+      [&](size_t, Rng&, PhotonBatch& batch) {
+        batch.tally[0] += 1.0f;
+        batch.collisions += 4.0 * kEventsPerPhoton;
+        ++traced;
+      },
+      &failures);
+  EXPECT_EQ(traced.load(), size_t(kPhotonBatches * 3));
+  EXPECT_NEAR(sum[0], double(total), 1e-4);
+}
+
+TEST(PhotonTracer, RejectionFailureIsExplicitAndKeepsTheDirection) {
+  int draws = 0;
+  Vec3 w(0, 0, 1);
+  const bool drawn = sample_by_rejection(
+      &w, [&] { return ++draws, Vec3(1, 0, 0); }, [](const Vec3&) { return false; });
+  EXPECT_FALSE(drawn);
+  EXPECT_EQ(draws, kMaxRejectionTries);
+  EXPECT_EQ(w, Vec3(0, 0, 1));
+  draws = 0;
+  EXPECT_TRUE(sample_by_rejection(
+      &w, [&] { return Vec3(0, ++draws, 0); }, [&](const Vec3&) { return draws == 3; }));
+  EXPECT_EQ(w, Vec3(0, 3, 0));
+}
+
+TEST(PhotonTracer, GridsOfAUsualSceneHaveNoRejectionFailures) {
+  Scene scene = test::scene_from_json("{" + test::camera_json(8, 8) + R"(,
+    "media": [{"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1}, "sigma_s": 4.0, "sigma_a": 0.05,
+               "phase": {"type": "hg", "g": 0.8}}],
+    "lights": [{"type": "directional", "direction": [-1, 0.3, 0.2], "irradiance": 1.0}]})");
+  const SceneContext ctx(scene);
+  const nlohmann::json options = {{"photon_transport", "similarity"}, {"photons", 1 << 14}, {"beam_photons", 1 << 12}};
+  const MfsIntegrator mfs(ctx, parse_mfs_settings(options, "test", true));
+  ASSERT_NE(mfs.scatter_grid(), nullptr);
+  ASSERT_NE(mfs.beam_grid(), nullptr);
+  EXPECT_EQ(mfs.scatter_grid()->rejection_failures(), 0u);
+  EXPECT_EQ(mfs.beam_grid()->rejection_failures(), 0u);
+}
+
+}  // namespace
+}  // namespace nimbus
