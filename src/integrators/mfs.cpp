@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include "integrators/mfs_estimators.h"
 #include "integrators/tracking.h"
 #include "core/json_reader.h"
 #include "nimbus/error.h"
@@ -131,157 +132,95 @@ size_t MfsIntegrator::memory_bytes() const {
   return bytes;
 }
 
-namespace {
-// 1 / cosh(sqrt(theta tau)): the extra loss on paths lengthened by peak deflections (the corrected MFS
-// kernel's total, W / cosh(z / L) with (z / L)^2 = a theta2 b z^2; notes/mfs-math.md), for an
-// accumulated angular diffusion theta = int theta2 dtau_peak and loss depth tau (wide scatters and
-// absorption).
-double lengthening(double theta, double tau) {
-  const double x = std::sqrt(std::max(0.0, theta * tau));
-  const double e = std::exp(-x);
-  return 2.0 * e / (1.0 + e * e);
-}
-}  // namespace
-
-Rgb MfsIntegrator::radiance(const Vec3& o, const Vec3& d, Rng& rng) const {
-  // T_full: plain transmittance (background); T_red: reduced extinction (wide scatters and absorption);
-  // tau_p: peak optical depth, all from the camera to the current point.
-  // theta_p: the accumulated angular diffusion int theta2 dtau_p (per-component mean square angle of the
-  // peaks), tau_red = -ln T_red: together the path-lengthening factor 1 / cosh(sqrt(theta_p tau_red)).
-  Rgb L(0.0), T_full(1.0), T_red(1.0), tau_p(0.0), theta_p(0.0), tau_red(0.0);
-  // Moments int theta2 sigma_peak s^k ds (k = 0, 1, 2; s from the ray's origin, largest channel): the
-  // lateral variance of the light that reaches the camera from depth t is t^2 m0 - 2 t m1 + m2.
-  double m0 = 0.0, m1 = 0.0, m2 = 0.0;
+// The radiance along the camera ray as the sum of the estimators in mfs_estimators.h over a march fixed
+// in optical depth (docs/derivations.md: eq. D7 for the first wide scatter and the forward peak, D11 for
+// forward_side "light", D12 for the higher orders, D13 for the growing steps).
+Rgb MfsIntegrator::Li(const Ray& ray, Rng& rng) const {
+  const Vec3 &o = ray.o, &d = ray.d;
+  Rgb L(0.0);
+  CameraPath cam;  // from the camera to the current step: T_full, T_red, tau_p, theta_p, tau_red, m0..m2
   const double jitter = rng.uniform();
   MediumPoint mp;
-  // Steps grow with the camera-side reduced depth: tau_step (1 + step_growth tau_red).
-  march_growing(ctx_.majorants, o, d, std::numeric_limits<double>::infinity(), s_.tau_step, jitter,
-        [&] { return 1.0 + s_.step_growth * max_component(tau_red); },
-        [&](const Vec3& p, double t, double dt) {
-          ctx_.media.eval(p, &mp);
-          Rgb sigma_peak(0.0), sigma_theta(0.0);
+  march_growing(
+      ctx_.majorants, o, d, std::numeric_limits<double>::infinity(), s_.tau_step, jitter,
+      // Steps grow with the camera-side reduced depth: tau_step (1 + step_growth tau_red) (eq. D13).
+      [&] { return 1.0 + s_.step_growth * max_component(cam.tau_red); },
+      [&](const Vec3& p, double t, double dt) {
+        // Split the extinction at p into peak and reduced parts (eq. D2).
+        ctx_.media.eval(p, &mp);
+        const MfsExtinction k = mfs_extinction(mp, f_, theta2_);
+        // Add what each medium scatters towards the camera at the sample point y = p.
+        if (max_component(mp.sigma_s) > 0.0) {
+          const CameraPoint y = cam.at(k, jitter, dt, s_.light_side(), s_.path_lengthening);
+          Rgb in_scatter(0.0), peak_scatter(0.0);  // reach the camera through y.T_cam / y.T_full
           for (int i = 0; i < mp.count; ++i) {
-            sigma_peak += mp.sigma_s_i[i] * f_[i];
-            sigma_theta += mp.sigma_s_i[i] * (f_[i] * theta2_[i]);
+            if (max_component(mp.sigma_s_i[i]) <= 0.0) continue;
+            const MediumRadiance Lm = medium_radiance(i, p, d, t, y, cam, rng);
+            in_scatter += mp.sigma_s_i[i] * Lm.L;
+            peak_scatter += mp.sigma_s_i[i] * Lm.L_peak;
           }
-          const Rgb sigma_red = mp.sigma_t() - sigma_peak;
-          if (max_component(mp.sigma_s) > 0.0) {
-            // Camera-side depths at the sample point.
-            Rgb T_here = s_.light_side() ? T_full * exp(-mp.sigma_t() * (jitter * dt))
-                                       : T_red * exp(-sigma_red * (jitter * dt));
-            if (!s_.light_side() && s_.path_lengthening)
-              for (int c = 0; c < 3; ++c)
-                T_here[c] *= lengthening(theta_p[c] + sigma_theta[c] * jitter * dt,
-                                         tau_red[c] + sigma_red[c] * jitter * dt);
-            const Rgb tp = tau_p + sigma_peak * (jitter * dt);
-            Rgb in_scatter(0.0), peak_scatter(0.0);  // towards the camera through T_here / T_full
-            for (int i = 0; i < mp.count; ++i) {
-              if (max_component(mp.sigma_s_i[i]) <= 0.0) continue;
-              const PhaseSplit& split = *splits_[i];
-              const double f = f_[i];
-              Rgb Li(0.0), Li_peak(0.0);
-              // Directional and point lights: wide term and peak term.
-              for (size_t l = 0; l < ctx_.lights.size(); ++l) {
-                LightSample ls;
-                const double u1 = rng.uniform(), u2 = rng.uniform();
-                if (!sample_light(ctx_.lights[l], p, u1, u2, &ls)) continue;
-                const double mu = dot(d, ls.wi);
-                const Rgb T_light = full_maps_[l].lookup(p);
-                Rgb T_wide = s_.forward_light_path() ? reduced_maps_[l].lookup(p) : T_light;
-                // Light-side peak depth ln(T_wide / T_light) and its path lengthening: from the
-                // photon-traced beam where there is one (its loss factor, and the peak depth whose
-                // spread has the beam's mean cosine), else the straight-line picture and, optionally,
-                // the corrected kernel's 1 / cosh.
-                Rgb tps(0.0), R(1.0), mean_cos(1.0);
-                const bool traced = beam_ && beam_->lookup(l, p, &R, &mean_cos);
-                const double one_minus_chi1 = 1.0 - (split.peak_moments().size() > 1 ? split.peak_moments()[1] : 1.0);
-                for (int c = 0; c < 3; ++c) {
-                  if (traced) {
-                    T_wide[c] *= R[c];
-                    tps[c] = one_minus_chi1 > 0.0
-                                 ? std::min(PhaseSplit::kTauMax, -std::log(std::max(mean_cos[c], 1e-12)) / one_minus_chi1)
-                                 : 0.0;
-                    continue;
-                  }
-                  tps[c] = T_light[c] > 1e-30 ? std::max(0.0, std::log(T_wide[c] / T_light[c]))
-                                              : PhaseSplit::kTauMax;
-                  if (s_.forward_light_path() && s_.path_lengthening && T_wide[c] > 0.0)
-                    T_wide[c] *= lengthening(theta2_[i] * tps[c], -std::log(T_wide[c]));
-                }
-                if (s_.light_side()) {
-                  // The light's peak-only (zero wide scatter) beam at p: total T_wide, spread by the
-                  // light-side peak depth ln(T_wide / T_light); scattered by the whole phase function.
-                  for (int c = 0; c < 3; ++c) {
-                    Li[c] += ls.weight[c] * T_wide[c] *
-                             ((1.0 - f) * split.wide_eff(tps[c], mu) + f * split.peak_eff(tps[c], mu));
-                  }
-                  continue;
-                }
-                for (int c = 0; c < 3; ++c) {
-                  // The first wide scatter: the beam arrives spread by its light-side peak depth, the
-                  // scattered light is spread again by the camera-side one; on the sphere these
-                  // convolutions multiply the Legendre moments, so the depths add.
-                  if (s_.large_angle_scatters != 0)
-                    Li[c] += ls.weight[c] * (1.0 - f) * split.wide_eff(tp[c] + (s_.light_blur ? tps[c] : 0.0), mu) *
-                             T_wide[c];
-                  if (s_.forward_light_path()) {
-                    // Paths without a wide scatter, counted at their last peak scatter (here): the light's
-                    // forward-scattered beam (total T_wide, spread by the light-side peak depth
-                    // ln(T_wide / T_light)), then straight to the camera (plain transmittance).
-                    Li_peak[c] += ls.weight[c] * f * split.peak_eff(tps[c], mu) * T_wide[c];
-                  } else {
-                    // beer_lambert: first (peak) scatter here, unscattered light, the propagator to the
-                    // camera.
-                    Li[c] += ls.weight[c] * f * split.peak_eff(tp[c], mu) * T_light[c];
-                  }
-                }
-              }
-              // Light that already took wide scatters (and the environment's light): its last wide scatter
-              // is here.
-              if (grid_) {
-                const std::vector<double>& chi_w = split.wide_moments();
-                const std::vector<double>& chi_p = split.peak_moments();
-                auto moment = [](const std::vector<double>& m, int l, double fallback) {
-                  return int(m.size()) > l ? m[l] : fallback;
-                };
-                std::array<Rgb, kShMaxBands> chi;
-                for (int l = 0; l < grid_->bands(); ++l) {
-                  for (int c = 0; c < 3; ++c) {
-                    chi[l][c] =
-                        s_.light_side()
-                            // Every scatter at p (whole phase function); the camera leg is exact.
-                            ? f * moment(chi_p, l, 1.0) + (1.0 - f) * moment(chi_w, l, 0.0)
-                            // The wide part's moments after the camera-side peak blur.
-                            : moment(chi_w, l, 0.0) * std::exp(-tp[c] * (1.0 - moment(chi_p, l, 1.0)));
-                  }
-                }
-                const double spread = std::sqrt(std::max(0.0, t * t * m0 - 2.0 * t * m1 + m2));
-                Li += (s_.light_side() ? 1.0 : 1.0 - f) *
-                      (s_.filtered_lookups && !s_.light_side() ? grid_->scattered_filtered(p, -d, chi, spread)
-                                                             : grid_->scattered(p, -d, chi));
-              }
-              in_scatter += mp.sigma_s_i[i] * Li;
-              peak_scatter += mp.sigma_s_i[i] * Li_peak;
-            }
-            L += (T_here * in_scatter + T_full * exp(-mp.sigma_t() * (jitter * dt)) * peak_scatter) * dt;
-          }
-          T_full *= exp(-mp.sigma_t() * dt);
-          T_red *= exp(-sigma_red * dt);
-          tau_p += sigma_peak * dt;
-          theta_p += sigma_theta * dt;
-          tau_red += sigma_red * dt;
-          {
-            const double a = max_component(sigma_theta) * dt, tm = t + (0.5 - jitter) * dt;  // step midpoint
-            m0 += a;
-            m1 += a * tm;
-            m2 += a * tm * tm;
-          }
-          return max_component(s_.light_side() ? T_full : T_red) > 1e-6;
-        });
-  // The environment behind the medium; its scattered light is in the grid. Camera side: its peak-scattered
-  // light stays on the ray (smooth in angle), so it is attenuated by the reduced extinction only.
-  if (ctx_.has_environment) L += (s_.light_side() ? T_full : T_red) * ctx_.environment;
+          L += (y.T_cam * in_scatter + y.T_full * peak_scatter) * dt;
+        }
+        // Advance the camera-side state over the whole step.
+        cam.advance(k, t, dt, jitter);
+        return max_component(s_.light_side() ? cam.T_full : cam.T_red) > 1e-6;
+      });
+  // Add the environment behind the medium; its scattered light is in the grid. Camera side: its
+  // peak-scattered light stays on the ray (smooth in angle), so only the reduced extinction removes it.
+  if (ctx_.has_environment) L += (s_.light_side() ? cam.T_full : cam.T_red) * ctx_.environment;
   return L;
+}
+
+MfsIntegrator::MediumRadiance MfsIntegrator::medium_radiance(int i, const Vec3& p, const Vec3& d, double t,
+                                                             const CameraPoint& y, const CameraPath& cam,
+                                                             Rng& rng) const {
+  const PhaseSplit& split = *splits_[i];
+  const double f = f_[i];
+  MediumRadiance out{Rgb(0.0), Rgb(0.0)};
+  // Sample every light once (u1, u2, in this order) and add its first wide scatter and forward peak.
+  for (size_t l = 0; l < ctx_.lights.size(); ++l) {
+    LightSample ls;
+    const double u1 = rng.uniform(), u2 = rng.uniform();
+    if (!sample_light(ctx_.lights[l], p, u1, u2, &ls)) continue;
+    const double mu = dot(d, ls.wi);
+    const LightBeam beam = light_beam(l, i, p);
+    if (s_.light_side()) {
+      out.L += light_side_scatter(ls.weight, f, split, mu, beam.tau_ps, beam.T_wide);  // eq. D11
+      continue;
+    }
+    if (s_.large_angle_scatters != 0)  // eq. D7, first term
+      out.L += first_wide_scatter(ls.weight, f, split, mu, y.tau_p, s_.light_blur ? beam.tau_ps : Rgb(0.0),
+                                 beam.T_wide);
+    if (s_.forward_light_path())  // eq. D7, second term: to the camera with T_full
+      out.L_peak += forward_peak(ls.weight, f, split, mu, beam.tau_ps, beam.T_wide);
+    else  // eq. D7b (beer_lambert)
+      out.L += forward_peak(ls.weight, f, split, mu, y.tau_p, beam.T_light);
+  }
+  // Add the light that already took wide scatters (and the environment's): its last wide scatter is at y.
+  if (grid_) out.L += higher_orders(i, p, d, t, y.tau_p, cam);
+  return out;
+}
+
+LightBeam MfsIntegrator::light_beam(size_t l, int i, const Vec3& p) const {
+  const Rgb T_light = full_maps_[l].lookup(p);
+  const Rgb T_wide = s_.forward_light_path() ? reduced_maps_[l].lookup(p) : T_light;
+  Rgb R(1.0), mean_cos(1.0);
+  const bool traced = beam_ && beam_->lookup(l, p, &R, &mean_cos);
+  return peak_only_beam(T_light, T_wide, traced, R, mean_cos, splits_[i]->peak_moments(), theta2_[i],
+                        s_.forward_light_path() && s_.path_lengthening);
+}
+
+Rgb MfsIntegrator::higher_orders(int i, const Vec3& p, const Vec3& d, double t, const Rgb& tau_p,
+                                 const CameraPath& cam) const {
+  const PhaseSplit& split = *splits_[i];
+  const double f = f_[i];
+  // forward_side "light": the whole phase function at y, exact camera leg (eq. D12 with D1's moments).
+  if (s_.light_side()) return grid_->scattered(p, -d, whole_phase_moments(split, f, grid_->bands()));
+  // Camera side: the wide part, its moments blurred by the camera-side peak depth (eqs. D3, D12),
+  // optionally read pre-filtered over the camera-side lateral spread (eq. D10).
+  const std::array<Rgb, kShMaxBands> chi = blurred_wide_moments(split, tau_p, grid_->bands());
+  return (1.0 - f) * (s_.filtered_lookups ? grid_->scattered_filtered(p, -d, chi, cam.lateral_spread(t))
+                                          : grid_->scattered(p, -d, chi));
 }
 
 }  // namespace nimbus

@@ -1,35 +1,28 @@
-// `mfs`: one large-angle scatter carried to the camera by the multiple-forward-scattering propagator
-// (seed eq. 3 / corrected eq. 17, steady state; design in docs/validation/render.md).
+// `mfs`: Tessendorf's multiple forward scattering (seed eq. 3 / corrected eq. 17, steady state) as a
+// march along the camera ray. The derivations, numbered D1 .. D13, are in docs/derivations.md; the
+// estimators are free functions in integrators/mfs_estimators.h; design and accuracy in
+// docs/validation/render.md.
 //
-// Each medium's phase function is split P = f P_peak + (1 - f) P_wide (transport/phase_split.h). Peak
-// scatters are small deflections carried by the generalised small-angle propagator; wide scatters are
-// discrete events. Along the camera ray (march fixed in optical depth, jittered once per camera ray,
-// as `single`) a point y at camera-side peak depth tau_p and reduced optical depth
-// tau_r = int (sigma_a + (1 - f) sigma_s) receives light and sends towards the camera
-//     sigma_s E_light [ (1 - f) T_light'(y) P_wide_eff(tau_p, mu) + f T_light(y) P_peak_eff(tau_p, mu) ]
-//     exp(-tau_r)
-// with mu the cosine between the light's and the camera-bound propagation directions:
-//  - the wide term: the FIRST wide scatter of the path happens at y; light_path "forward" lets the light
-//    reach y through peak scatters only (T_light' with the reduced extinction; the beam's angular spread on the
-//    light side blurs P_wide_eff further: its peak depth adds to tau_p, option light_blur), "beer_lambert"
-//    (paper-faithful) only unscattered (T_light = exp(-tau_t));
-//    with beam_photons > 0 (default) T_light' is corrected by the photon-traced peak-only beam
-//    (BeamGrid: lengthened paths, light leaving through the medium's sides) and the light-side angular
-//    spread is the one with the beam's measured mean cosine;
-//  - the peak term: paths with no wide scatter at all (the light seen through the forward peak: silver
-//    linings), counted at their last peak scatter at y: the light's forward beam (its light-side
-//    spread), then straight to the camera with the plain transmittance.
-// Paths with two or more wide scatters (large_angle_scatters K > 1, default all): the light that has
-// already scattered widely 1 .. K-1 times comes from a photon-traced fluence-and-flux grid
-// (integrators/scatter_grid.h) and takes its last wide scatter at y:
-//     sigma_s (1 - f) (phi + 3 g_wide_eff(tau_p) F . w_o) / (4 pi)
-// with g_wide_eff = g_wide exp(-tau_p (1 - chi_1^peak)) (the camera-side peak blur of its mean cosine).
-// Option filtered_lookups reads that grid pre-filtered (mip-mapped) over the lateral spread of the
-// camera-side propagator, which grows with depth (seed sec. 1); the march's steps grow with the
-// camera-side reduced depth (step_growth).
-// Light transmittances come from deep shadow maps (deterministic). The environment (smooth in angle) is
-// carried by the scatter grid from its entry, so the camera ray needs no environment sampling.
-// Every channel uses its own optical depths; overlapping media share one tau_p (sum of f_i sigma_s_i).
+// Each medium's phase function is split P = f P_peak + (1 - f) P_wide (D1, transport/phase_split.h).
+// Peak scatters are small deflections carried by the generalised small-angle propagator (D3: they spread
+// the light's direction without removing it, D2); wide scatters are discrete events. At each march point
+// y (steps fixed in optical depth, jittered once per camera ray, growing with depth: D13) every medium
+// sends towards the camera, per light sample:
+//  - the FIRST wide scatter of the path (D7): the light reaches y through peak scatters only (T_wide,
+//    the reduced shadow map, corrected by the photon-traced beam grid's R: D6, D9) spread by its
+//    light-side peak depth, and is spread again on the camera side: wide_eff at the summed depths (D4);
+//    light_path "beer_lambert" (paper-faithful) takes only unscattered light to y;
+//  - the forward peak alone (D7): paths with no wide scatter, counted at their last peak scatter at y,
+//    then straight to the camera with the plain transmittance (silver linings);
+//  - with large_angle_scatters K > 1 (default all), the light that has already scattered widely, from a
+//    photon-traced scatter grid (integrators/scatter_grid.h), by Funk-Hecke with the wide part's moments
+//    blurred by the camera-side peak depth (D12), optionally pre-filtered over the camera-side lateral
+//    spread (D10).
+// Camera-side light is attenuated by the reduced extinction (times the 1 / cosh path lengthening, D5,
+// with path_lengthening). forward_side "light" (D11) instead spreads everything on the light's side and
+// takes the camera leg exactly. Light transmittances come from deep shadow maps (deterministic); the
+// environment is carried by the scatter grid from its entry. Every channel uses its own optical depths;
+// overlapping media share one tau_p (sum of f_i sigma_s_i).
 //
 // Options (the JSON fields of the scene's integrator block besides type, spp, seed, max_events; the
 // settings struct's fields carry the same names; docs/scene-format.md says more):
@@ -63,6 +56,7 @@
 
 #include "integrators/beam_grid.h"
 #include "integrators/integrator.h"
+#include "integrators/mfs_estimators.h"
 #include "integrators/scatter_grid.h"
 #include "integrators/shadow_map.h"
 #include "scene/lights.h"
@@ -106,11 +100,10 @@ class MfsIntegrator final : public Integrator {
  public:
   // seed: the scene's, for the photon grids.
   MfsIntegrator(const SceneContext& context, MfsSettings settings, uint64_t seed = 1);
-  Rgb Li(const Ray& ray, Rng& rng) const override { return radiance(ray.o, ray.d, rng); }
+  Rgb Li(const Ray& ray, Rng& rng) const override;
   // The settings with "auto" resolved (scatter_grid_resolution).
   nlohmann::json settings_json() const override { return to_json(s_); }
   const MfsSettings& settings() const { return s_; }
-  Rgb radiance(const Vec3& o, const Vec3& d, Rng& rng) const;
   const PhaseSplit& split(int medium) const { return *splits_[medium]; }
   const ScatterGrid* scatter_grid() const { return grid_.get(); }
   const BeamGrid* beam_grid() const { return beam_.get(); }
@@ -126,6 +119,21 @@ class MfsIntegrator final : public Integrator {
   std::vector<TransmittanceGrid> full_maps_, reduced_maps_;  // per light
   std::unique_ptr<ScatterGrid> grid_;                        // wide scatters 2 .. K (null for K = 1)
   std::unique_ptr<BeamGrid> beam_;                           // the peak-only beams' correction (or null)
+
+  // The parts of `Li` (mfs.cpp); the physics is in mfs_estimators.h.
+  struct MediumRadiance {
+    Rgb L;       // per unit sigma_s_i, reaching the camera through CameraPoint::T_cam
+    Rgb L_peak;  // the forward-peak-only paths (light_path "forward"), through CameraPoint::T_full
+  };
+  // What medium i sends towards the camera from the sample point p (at distance t) of the march: one
+  // sample of every light (eqs. D7, D11) and the scatter grid's higher orders (eq. D12).
+  MediumRadiance medium_radiance(int i, const Vec3& p, const Vec3& d, double t, const CameraPoint& y,
+                                 const CameraPath& cam, Rng& rng) const;
+  // Light l's peak-only beam at p for medium i: shadow maps, beam grid (eqs. D8, D9).
+  LightBeam light_beam(size_t l, int i, const Vec3& p) const;
+  // The scatter grid's light, taking its last wide scatter at p towards the camera (eq. D12).
+  Rgb higher_orders(int i, const Vec3& p, const Vec3& d, double t, const Rgb& tau_p,
+                    const CameraPath& cam) const;
 };
 
 }  // namespace nimbus

@@ -66,7 +66,7 @@ TEST(PhotonTracer, GridsOfAUsualSceneHaveNoRejectionFailures) {
     "lights": [{"type": "directional", "direction": [-1, 0.3, 0.2], "irradiance": 1.0}]})");
   const SceneContext ctx(scene);
   const nlohmann::json options = {{"photon_transport", "similarity"}, {"photons", 1 << 14}, {"beam_photons", 1 << 12}};
-  const MfsIntegrator mfs(ctx, parse_mfs_settings(options, "test", true));
+  const MfsIntegrator mfs(ctx, mfs_settings_from_json(options, "test"));
   ASSERT_NE(mfs.scatter_grid(), nullptr);
   ASSERT_NE(mfs.beam_grid(), nullptr);
   EXPECT_EQ(mfs.scatter_grid()->rejection_failures(), 0u);

@@ -1,0 +1,139 @@
+// The `mfs` estimators (see mfs_estimators.h); equations D1 .. D12 of docs/derivations.md.
+#include "integrators/mfs_estimators.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace nimbus {
+
+double path_lengthening(double theta, double tau) {
+  // docs/derivations.md eq. D5: 1 / cosh(x) = 2 e^-x / (1 + e^-2x), x = sqrt(theta tau).
+  const double x = std::sqrt(std::max(0.0, theta * tau));
+  const double e = std::exp(-x);
+  return 2.0 * e / (1.0 + e * e);
+}
+
+MfsExtinction mfs_extinction(const MediumPoint& mp, const std::vector<double>& f,
+                             const std::vector<double>& theta2) {
+  // eq. D2: the peak part of each medium's scattering is not extinction for forward-carried light.
+  MfsExtinction k;
+  k.sigma_t = mp.sigma_t();
+  k.sigma_peak = Rgb(0.0);
+  k.sigma_theta = Rgb(0.0);
+  for (int i = 0; i < mp.count; ++i) {
+    k.sigma_peak += mp.sigma_s_i[i] * f[i];
+    k.sigma_theta += mp.sigma_s_i[i] * (f[i] * theta2[i]);
+  }
+  k.sigma_red = k.sigma_t - k.sigma_peak;
+  return k;
+}
+
+CameraPoint CameraPath::at(const MfsExtinction& k, double jitter, double dt, bool light_side,
+                           bool lengthening) const {
+  CameraPoint y;
+  y.T_full = T_full * exp(-k.sigma_t * (jitter * dt));
+  if (light_side) {
+    y.T_cam = y.T_full;
+  } else {
+    // Light scattered at y is carried to the camera by the propagator: only absorption and wide
+    // scatters remove it (eq. D2), and its lengthened paths lose eq. D5.
+    y.T_cam = T_red * exp(-k.sigma_red * (jitter * dt));
+    if (lengthening)
+      for (int c = 0; c < 3; ++c)
+        y.T_cam[c] *= path_lengthening(theta_p[c] + k.sigma_theta[c] * jitter * dt,
+                                       tau_red[c] + k.sigma_red[c] * jitter * dt);
+  }
+  y.tau_p = tau_p + k.sigma_peak * (jitter * dt);
+  return y;
+}
+
+void CameraPath::advance(const MfsExtinction& k, double t, double dt, double jitter) {
+  T_full *= exp(-k.sigma_t * dt);
+  T_red *= exp(-k.sigma_red * dt);
+  tau_p += k.sigma_peak * dt;
+  theta_p += k.sigma_theta * dt;
+  tau_red += k.sigma_red * dt;
+  // eq. D10's moments, by the midpoint rule over the step.
+  const double a = max_component(k.sigma_theta) * dt, tm = t + (0.5 - jitter) * dt;
+  m0 += a;
+  m1 += a * tm;
+  m2 += a * tm * tm;
+}
+
+double CameraPath::lateral_spread(double t) const {
+  // eq. D10: variance t^2 m0 - 2 t m1 + m2 = int theta2 sigma_peak (t - s)^2 ds.
+  return std::sqrt(std::max(0.0, t * t * m0 - 2.0 * t * m1 + m2));
+}
+
+LightBeam peak_only_beam(const Rgb& T_light, const Rgb& T_wide, bool traced, const Rgb& R,
+                         const Rgb& mean_cos, const std::vector<double>& peak_moments, double theta2,
+                         bool lengthening) {
+  LightBeam b{T_light, T_wide, Rgb(0.0)};
+  const double one_minus_chi1 = 1.0 - (peak_moments.size() > 1 ? peak_moments[1] : 1.0);
+  for (int c = 0; c < 3; ++c) {
+    if (traced) {
+      // eq. D9: the traced beam's loss R, and the peak depth whose spread has its mean cosine (eq. D3
+      // at l = 1: mean_cos = exp(-tau_ps (1 - chi_1^peak))).
+      b.T_wide[c] *= R[c];
+      b.tau_ps[c] = one_minus_chi1 > 0.0
+                        ? std::min(PhaseSplit::kTauMax, -std::log(std::max(mean_cos[c], 1e-12)) / one_minus_chi1)
+                        : 0.0;
+      continue;
+    }
+    // eq. D8: the straight beam's peak depth ln(T_wide / T_light), and optionally eq. D5.
+    b.tau_ps[c] = T_light[c] > 1e-30 ? std::max(0.0, std::log(b.T_wide[c] / T_light[c])) : PhaseSplit::kTauMax;
+    if (lengthening && b.T_wide[c] > 0.0)
+      b.T_wide[c] *= path_lengthening(theta2 * b.tau_ps[c], -std::log(b.T_wide[c]));
+  }
+  return b;
+}
+
+Rgb first_wide_scatter(const Rgb& E, double f, const PhaseSplit& split, double mu, const Rgb& tau_p,
+                       const Rgb& tau_ps, const Rgb& T_wide) {
+  // eq. D7, first term: light- and camera-side peak depths add (eq. D4).
+  Rgb L;
+  for (int c = 0; c < 3; ++c) L[c] = E[c] * (1.0 - f) * split.wide_eff(tau_p[c] + tau_ps[c], mu) * T_wide[c];
+  return L;
+}
+
+Rgb forward_peak(const Rgb& E, double f, const PhaseSplit& split, double mu, const Rgb& tau, const Rgb& T) {
+  // eq. D7, second term (or D7b for beer_lambert).
+  Rgb L;
+  for (int c = 0; c < 3; ++c) L[c] = E[c] * f * split.peak_eff(tau[c], mu) * T[c];
+  return L;
+}
+
+Rgb light_side_scatter(const Rgb& E, double f, const PhaseSplit& split, double mu, const Rgb& tau_ps,
+                       const Rgb& T_wide) {
+  // eq. D11.
+  Rgb L;
+  for (int c = 0; c < 3; ++c)
+    L[c] = E[c] * T_wide[c] * ((1.0 - f) * split.wide_eff(tau_ps[c], mu) + f * split.peak_eff(tau_ps[c], mu));
+  return L;
+}
+
+namespace {
+double moment(const std::vector<double>& m, int l, double fallback) { return int(m.size()) > l ? m[l] : fallback; }
+}  // namespace
+
+std::array<Rgb, kShMaxBands> blurred_wide_moments(const PhaseSplit& split, const Rgb& tau_p, int bands) {
+  // eq. D12 with eq. D3's camera-side blur of the wide part.
+  const std::vector<double>& chi_w = split.wide_moments();
+  const std::vector<double>& chi_p = split.peak_moments();
+  std::array<Rgb, kShMaxBands> chi{};
+  for (int l = 0; l < bands; ++l)
+    for (int c = 0; c < 3; ++c) chi[l][c] = moment(chi_w, l, 0.0) * std::exp(-tau_p[c] * (1.0 - moment(chi_p, l, 1.0)));
+  return chi;
+}
+
+std::array<Rgb, kShMaxBands> whole_phase_moments(const PhaseSplit& split, double f, int bands) {
+  // eq. D12 with eq. D1's moments (chi_l of P itself).
+  const std::vector<double>& chi_w = split.wide_moments();
+  const std::vector<double>& chi_p = split.peak_moments();
+  std::array<Rgb, kShMaxBands> chi{};
+  for (int l = 0; l < bands; ++l)
+    for (int c = 0; c < 3; ++c) chi[l][c] = f * moment(chi_p, l, 1.0) + (1.0 - f) * moment(chi_w, l, 0.0);
+  return chi;
+}
+
+}  // namespace nimbus

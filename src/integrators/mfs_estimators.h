@@ -1,0 +1,97 @@
+// The estimators of the `mfs` integrator (integrators/mfs.h) as free functions: the camera-side state
+// along the march, the light-side peak-only beam, and the radiance that one medium sends towards the
+// camera from a march point y by each of the four kinds of path. Pure math on values the integrator
+// looks up (shadow maps, beam grid, scatter grid); no scene. The equations (D1, D2, ...) are in
+// docs/derivations.md; the code uses its names.
+//
+// All quantities are per channel (Rgb) where the media are chromatic; f, theta2 and the split are per
+// medium. The floating-point operations are written in the order the images were made with: keep it.
+#pragma once
+
+#include <array>
+#include <vector>
+
+#include "core/math.h"
+#include "core/sh.h"
+#include "media/media.h"
+#include "transport/phase_split.h"
+
+namespace nimbus {
+
+// 1 / cosh(sqrt(theta tau)): the extra loss on paths lengthened by peak deflections, for an accumulated
+// angular diffusion theta = int theta2 dtau_p and loss depth tau (wide scatters and absorption)
+// (docs/derivations.md eq. D5).
+double path_lengthening(double theta, double tau);
+
+// The peak split of the extinction at a point, summed over the media present (eq. D2):
+//     sigma_peak = sum_i f_i sigma_s_i, sigma_theta = sum_i f_i theta2_i sigma_s_i,
+//     sigma_red = sigma_t - sigma_peak (the reduced extinction: absorption and wide scatters).
+struct MfsExtinction {
+  Rgb sigma_t, sigma_peak, sigma_theta, sigma_red;
+};
+MfsExtinction mfs_extinction(const MediumPoint& mp, const std::vector<double>& f,
+                             const std::vector<double>& theta2);
+
+// What the camera-side state gives at the march's sample point y.
+struct CameraPoint {
+  Rgb T_full;  // plain transmittance y -> camera (the forward-peak paths' last leg, eq. D7)
+  Rgb T_cam;   // transmittance of light scattered at y: T_red (times eq. D5) or, light side, T_full
+  Rgb tau_p;   // camera-side peak depth at y
+};
+
+// The camera-side state along the march, from the camera to the current step's start (eqs. D2, D5, D10):
+// T_full = exp(-tau_t), T_red = exp(-tau_red), the peak depth tau_p, the angular diffusion
+// theta_p = int theta2 dtau_p, and the lateral-spread moments m_k = int theta2 sigma_peak s^k ds
+// (k = 0, 1, 2, s from the ray's origin, largest channel).
+struct CameraPath {
+  Rgb T_full{1.0}, T_red{1.0}, tau_p{0.0}, theta_p{0.0}, tau_red{0.0};
+  double m0 = 0.0, m1 = 0.0, m2 = 0.0;
+
+  // The state at the sample point y = jitter dt into the step (the march's offset).
+  // light_side: light scattered at y goes to the camera unscattered (T_cam = T_full); otherwise it is
+  // carried by the propagator (T_cam = T_red, times eq. D5 when path_lengthening).
+  CameraPoint at(const MfsExtinction& k, double jitter, double dt, bool light_side,
+                 bool path_lengthening) const;
+  // The whole step [t - jitter dt, t + (1 - jitter) dt] (moments at its midpoint).
+  void advance(const MfsExtinction& k, double t, double dt, double jitter);
+  // Lateral standard deviation of the light that reaches the camera from depth t (eq. D10).
+  double lateral_spread(double t) const;
+};
+
+// One light's peak-only beam at y (light that has taken no wide scatter yet; eqs. D6, D8, D9).
+struct LightBeam {
+  Rgb T_light;  // plain transmittance to the light (shadow map)
+  Rgb T_wide;   // reduced transmittance (T_light for beer_lambert), times R or eq. D5
+  Rgb tau_ps;   // light-side peak depth: the beam's angular spread
+};
+// From the shadow maps' T_light and T_wide, and from the beam grid where it covers y (traced: R and the
+// beam's mean cosine); peak_moments: the medium's chi_l^peak; theta2: its peak's mean square angle.
+// path_lengthening (forward light path only) applies eq. D5 to the straight beam.
+LightBeam peak_only_beam(const Rgb& T_light, const Rgb& T_wide, bool traced, const Rgb& R,
+                         const Rgb& mean_cos, const std::vector<double>& peak_moments, double theta2,
+                         bool path_lengthening);
+
+// The estimators: radiance per unit sigma_s_i that medium i (split, peak fraction f) sends towards the
+// camera from y, for a light of weight E (radiance or irradiance per sample) at cosine mu between the
+// light's and the camera-bound propagation directions.
+
+// The first wide scatter at y (eq. D7, first term): E (1 - f) wide_eff(tau_p + tau_ps, mu) T_wide.
+// tau_ps = 0 without light_blur.
+Rgb first_wide_scatter(const Rgb& E, double f, const PhaseSplit& split, double mu, const Rgb& tau_p,
+                       const Rgb& tau_ps, const Rgb& T_wide);
+// The forward peak only (eq. D7, second term): E f peak_eff(tau, mu) T with (tau, T) = (tau_ps, T_wide),
+// the last peak scatter of a path with no wide scatter; beer_lambert (eq. D7b): (tau_p, T_light), the
+// first peak scatter of unscattered light.
+Rgb forward_peak(const Rgb& E, double f, const PhaseSplit& split, double mu, const Rgb& tau, const Rgb& T);
+// forward_side "light" (eq. D11): every scatter at y, whole phase function spread by the light side only:
+// E T_wide [(1 - f) wide_eff(tau_ps, mu) + f peak_eff(tau_ps, mu)].
+Rgb light_side_scatter(const Rgb& E, double f, const PhaseSplit& split, double mu, const Rgb& tau_ps,
+                       const Rgb& T_wide);
+
+// The Legendre moments of the last wide scatter for the scatter grid's Funk-Hecke sum (eq. D12), bands
+// l < bands: chi_l = chi_l^wide exp(-tau_p (1 - chi_l^peak)) (camera-side blur, eq. D3) ...
+std::array<Rgb, kShMaxBands> blurred_wide_moments(const PhaseSplit& split, const Rgb& tau_p, int bands);
+// ... or, forward_side "light", the whole phase function's f chi_l^peak + (1 - f) chi_l^wide.
+std::array<Rgb, kShMaxBands> whole_phase_moments(const PhaseSplit& split, double f, int bands);
+
+}  // namespace nimbus

@@ -1,0 +1,108 @@
+// The `mfs` estimators alone (integrators/mfs_estimators.h): each checked against the equation of
+// docs/derivations.md it cites, without a scene.
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "integrators/mfs_estimators.h"
+#include "transport/small_angle.h"
+
+namespace nimbus {
+namespace {
+
+TEST(MfsEstimators, PathLengtheningIsOneOverCosh) {  // eq. D5
+  EXPECT_EQ(path_lengthening(0.0, 5.0), 1.0);
+  EXPECT_EQ(path_lengthening(-1.0, 5.0), 1.0);  // clamped at 0
+  for (double theta : {0.01, 0.3, 2.0})
+    for (double tau : {0.1, 1.0, 30.0})
+      EXPECT_NEAR(path_lengthening(theta, tau), 1.0 / std::cosh(std::sqrt(theta * tau)), 1e-14);
+}
+
+TEST(MfsEstimators, ExtinctionSplitSumsTheMedia) {  // eq. D2
+  MediumPoint mp;
+  mp.count = 2;
+  mp.sigma_s_i[0] = Rgb(1.0, 2.0, 3.0);
+  mp.sigma_s_i[1] = Rgb(0.5);
+  mp.sigma_s = mp.sigma_s_i[0] + mp.sigma_s_i[1];
+  mp.sigma_a = Rgb(0.25);
+  const MfsExtinction k = mfs_extinction(mp, {0.8, 0.5}, {0.01, 0.1});
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_NEAR(k.sigma_peak[c], 0.8 * mp.sigma_s_i[0][c] + 0.25, 1e-12);
+    EXPECT_NEAR(k.sigma_theta[c], 0.008 * mp.sigma_s_i[0][c] + 0.025, 1e-12);
+    EXPECT_NEAR(k.sigma_red[c], 0.2 * mp.sigma_s_i[0][c] + 0.5, 1e-12);
+  }
+}
+
+TEST(MfsEstimators, CameraPathAccumulatesDepthsAndSpread) {  // eqs. D2, D10
+  MfsExtinction k{Rgb(2.0), Rgb(1.5), Rgb(0.03), Rgb(0.5)};
+  CameraPath cam;
+  const double dt = 0.01;
+  int n = 0;
+  for (double t = 0.5 * dt; n < 300; t += dt, ++n) cam.advance(k, t, dt, 0.5);
+  const double z = n * dt;
+  EXPECT_NEAR(cam.T_full[0], std::exp(-2.0 * z), 1e-12);
+  EXPECT_NEAR(cam.T_red[1], std::exp(-0.5 * z), 1e-12);
+  EXPECT_NEAR(cam.tau_p[2], 1.5 * z, 1e-12);
+  EXPECT_NEAR(cam.theta_p[0], 0.03 * z, 1e-12);
+  // Uniform sigma_theta: var(t) = sigma_theta int_0^z (t - s)^2 ds; at t = z, sigma_theta z^3 / 3.
+  EXPECT_NEAR(cam.lateral_spread(z), std::sqrt(0.03 * z * z * z / 3.0), 1e-4 * std::sqrt(0.03 * z * z * z / 3.0));
+  // The sample point half a step further, and the light-side choice of transmittance.
+  const CameraPoint y = cam.at(k, 0.5, dt, false, false), yl = cam.at(k, 0.5, dt, true, false);
+  EXPECT_NEAR(y.T_cam[0], std::exp(-0.5 * (z + 0.5 * dt)), 1e-12);
+  EXPECT_NEAR(y.tau_p[0], 1.5 * (z + 0.5 * dt), 1e-12);
+  EXPECT_EQ(yl.T_cam, yl.T_full);
+  const CameraPoint yc = cam.at(k, 0.5, dt, false, true);  // with eq. D5
+  EXPECT_NEAR(yc.T_cam[0], y.T_cam[0] / std::cosh(std::sqrt(0.03 * (z + 0.5 * dt) * 0.5 * (z + 0.5 * dt))), 1e-12);
+}
+
+TEST(MfsEstimators, PeakOnlyBeamDepths) {  // eqs. D8, D9
+  const std::vector<double> chi_p = {1.0, 0.9, 0.75};
+  const Rgb T_light(0.1, 0.2, 0.3), T_wide(0.5, 0.4, 0.3);
+  const LightBeam s = peak_only_beam(T_light, T_wide, false, Rgb(1.0), Rgb(1.0), chi_p, 0.05, false);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(s.tau_ps[c], std::log(T_wide[c] / T_light[c]), 1e-15);
+  EXPECT_EQ(s.T_wide, T_wide);
+  const LightBeam sl = peak_only_beam(T_light, T_wide, false, Rgb(1.0), Rgb(1.0), chi_p, 0.05, true);
+  EXPECT_NEAR(sl.T_wide[0], T_wide[0] * path_lengthening(0.05 * s.tau_ps[0], -std::log(T_wide[0])), 1e-15);
+  // Traced: R multiplies T_wide; the mean cosine of a beam after tau is exp(-tau (1 - chi_1)) (eq. D3).
+  const Rgb tau(0.0, 1.0, 7.0);
+  const Rgb mean_cos(std::exp(-tau[0] * 0.1), std::exp(-tau[1] * 0.1), std::exp(-tau[2] * 0.1));
+  const LightBeam b = peak_only_beam(T_light, T_wide, true, Rgb(0.5), mean_cos, chi_p, 0.05, true);
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_NEAR(b.tau_ps[c], tau[c], 1e-12);
+    EXPECT_DOUBLE_EQ(b.T_wide[c], 0.5 * T_wide[c]);
+  }
+}
+
+TEST(MfsEstimators, PeakDepthsAddInTheMoments) {  // eqs. D3, D4, D12
+  const Phase phase = HgPhase{0.85};
+  const PhaseSplit split(phase, auto_peak_fraction(phase));
+  const auto a = blurred_wide_moments(split, Rgb(0.7), 3), b = blurred_wide_moments(split, Rgb(1.8), 3);
+  const auto ab = blurred_wide_moments(split, Rgb(2.5), 3), none = blurred_wide_moments(split, Rgb(0.0), 3);
+  for (int l = 0; l < 3; ++l) EXPECT_NEAR(ab[l][0] * none[l][0], a[l][0] * b[l][0], 1e-12) << l;
+  EXPECT_NEAR(none[0][1], 1.0, 1e-6);
+  // The whole phase function's moments: chi_1 = g.
+  const auto whole = whole_phase_moments(split, split.f(), 3);
+  EXPECT_NEAR(whole[0][0], 1.0, 1e-9);
+  EXPECT_NEAR(whole[1][2], 0.85, 2e-3);
+}
+
+TEST(MfsEstimators, EstimatorsAreTheirFormulas) {  // eqs. D7, D7b, D11
+  const Phase phase = HgPhase{0.9};
+  const PhaseSplit split(phase, 0.6);
+  const double f = split.f(), mu = 0.8;
+  const Rgb E(1.0, 2.0, 0.5), tau_p(0.5, 1.0, 3.0), tau_ps(0.2, 0.0, 4.0), T(0.3, 0.6, 0.9);
+  const Rgb wide = first_wide_scatter(E, f, split, mu, tau_p, tau_ps, T);
+  const Rgb peak = forward_peak(E, f, split, mu, tau_ps, T);
+  const Rgb light = light_side_scatter(E, f, split, mu, tau_ps, T);
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_DOUBLE_EQ(wide[c], E[c] * (1.0 - f) * split.wide_eff(tau_p[c] + tau_ps[c], mu) * T[c]);
+    EXPECT_DOUBLE_EQ(peak[c], E[c] * f * split.peak_eff(tau_ps[c], mu) * T[c]);
+    EXPECT_NEAR(light[c], (1.0 - f) * E[c] * split.wide_eff(tau_ps[c], mu) * T[c] + peak[c], 1e-12 * light[c]);
+  }
+  // No spread on either side: the light side's scatter is the phase function itself.
+  const Rgb at0 = light_side_scatter(Rgb(1.0), f, split, mu, Rgb(0.0), Rgb(1.0));
+  EXPECT_NEAR(at0[0], phase_eval(phase, mu), 0.03 * phase_eval(phase, mu) + 1e-3);
+}
+
+}  // namespace
+}  // namespace nimbus
