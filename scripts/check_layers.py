@@ -110,7 +110,8 @@ def long_functions(path, lines):
             if depth == ns_depth and ch not in "{}":
                 sig += ch
             if ch == "{":
-                if depth == ns_depth and re.search(r"\bnamespace\b[^;{}()]*$", sig):
+                # namespaces, classes and structs: their members are the functions
+                if depth == ns_depth and re.search(r"\b(namespace|class|struct|union)\b[^;{}()]*$", sig):
                     ns_depth += 1
                 elif depth == ns_depth and start is None:
                     start = n

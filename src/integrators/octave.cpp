@@ -54,6 +54,36 @@ OctaveIntegrator::OctaveIntegrator(const SceneContext& context, OctaveSettings s
     maps_.emplace_back(ctx_.media, ctx_.majorants, l, s_.shadow_map_resolution, 0.05);
 }
 
+Rgb OctaveIntegrator::octave_scatter(int j, double bj, const Vec3& p, const Vec3& d, const MediumPoint& mp,
+                                     const LightSamples& lights, Rng& rng) const {
+  Rgb in_scatter(0.0);
+  for (int i = 0; i < mp.count; ++i) {
+    if (max_component(mp.sigma_s_i[i]) <= 0.0) continue;
+    const Phase& phase = phases_[j][i];
+    Rgb Li(0.0);
+    // Directional and point lights through the shadow maps, T^(b^j).
+    for (size_t l = 0; l < ctx_.lights.size(); ++l) {
+      if (!lights.ok[l]) continue;
+      const double f = phase_eval(phase, dot(d, lights.ls[l].wi));
+      Rgb T;
+      for (int c = 0; c < 3; ++c) T[c] = std::pow(std::max(float(lights.T[l][c]), 1e-30f), bj);
+      Li += lights.ls[l].weight * f * T;
+    }
+    // The environment: one phase-sampled direction, marched transmittance.
+    if (ctx_.has_environment) {
+      const double u1 = rng.uniform(), u2 = rng.uniform();
+      const Vec3 wi = phase_sample(phase, d, u1, u2);
+      const Rgb T = marched_transmittance(ctx_.media, ctx_.majorants, p, wi, std::numeric_limits<double>::infinity(),
+                                          0.25 / std::max(bj, 0.05));
+      Rgb Tb;
+      for (int c = 0; c < 3; ++c) Tb[c] = std::pow(std::max(T[c], 1e-300), bj);
+      Li += ctx_.environment * Tb;
+    }
+    in_scatter += mp.sigma_s_i[i] * Li;
+  }
+  return in_scatter;
+}
+
 Rgb OctaveIntegrator::Li(const Ray& ray, Rng& rng) const {
   const Vec3 &o = ray.o, &d = ray.d;
   const int N = s_.octaves;
@@ -66,49 +96,27 @@ Rgb OctaveIntegrator::Li(const Ray& ray, Rng& rng) const {
   Rgb L(0.0), tau(0.0);
   const double jitter = rng.uniform();
   MediumPoint mp;
+  LightSamples lights;
+  lights.ls.resize(ctx_.lights.size());
+  lights.T.resize(ctx_.lights.size());
+  lights.ok.resize(ctx_.lights.size());
   march(ctx_.majorants, o, d, std::numeric_limits<double>::infinity(), s_.tau_step, jitter,
         [&](const Vec3& p, double, double dt) {
           ctx_.media.eval(p, &mp);
           if (max_component(mp.sigma_s) > 0.0) {
             const Rgb tau_here = tau + mp.sigma_t() * (jitter * dt);
             // Light transmittance exp(-tau_l) once per light (octave j: raised to b^j).
-            std::vector<LightSample> ls(ctx_.lights.size());
-            std::vector<Rgb> tl(ctx_.lights.size());
-            std::vector<bool> ok(ctx_.lights.size());
             for (size_t l = 0; l < ctx_.lights.size(); ++l) {
               const double u1 = rng.uniform(), u2 = rng.uniform();
-              ok[l] = sample_light(ctx_.lights[l], p, u1, u2, &ls[l]);
-              if (ok[l]) tl[l] = maps_[l].lookup(p);
+              lights.ok[l] = sample_light(ctx_.lights[l], p, u1, u2, &lights.ls[l]);
+              if (lights.ok[l]) lights.T[l] = maps_[l].lookup(p);
             }
+            // Octave j: scattering a^j sigma_s seen through the camera-side transmittance exp(-b^j tau).
             for (int j = 0; j < N; ++j) {
               Rgb Tc;
               for (int c = 0; c < 3; ++c) Tc[c] = std::exp(-bj[j] * tau_here[c]);
               if (max_component(Tc) < 1e-7) continue;
-              Rgb in_scatter(0.0);
-              for (int i = 0; i < mp.count; ++i) {
-                if (max_component(mp.sigma_s_i[i]) <= 0.0) continue;
-                const Phase& phase = phases_[j][i];
-                Rgb Li(0.0);
-                for (size_t l = 0; l < ctx_.lights.size(); ++l) {
-                  if (!ok[l]) continue;
-                  const double f = phase_eval(phase, dot(d, ls[l].wi));
-                  Rgb T;
-                  for (int c = 0; c < 3; ++c) T[c] = std::pow(std::max(float(tl[l][c]), 1e-30f), bj[j]);
-                  Li += ls[l].weight * f * T;
-                }
-                if (ctx_.has_environment) {
-                  const double u1 = rng.uniform(), u2 = rng.uniform();
-                  const Vec3 wi = phase_sample(phase, d, u1, u2);
-                  const Rgb T = marched_transmittance(ctx_.media, ctx_.majorants, p, wi,
-                                                      std::numeric_limits<double>::infinity(),
-                                                      0.25 / std::max(bj[j], 0.05));
-                  Rgb Tb;
-                  for (int c = 0; c < 3; ++c) Tb[c] = std::pow(std::max(T[c], 1e-300), bj[j]);
-                  Li += ctx_.environment * Tb;
-                }
-                in_scatter += mp.sigma_s_i[i] * Li;
-              }
-              L += Tc * in_scatter * (aj[j] * dt);
+              L += Tc * octave_scatter(j, bj[j], p, d, mp, lights, rng) * (aj[j] * dt);
             }
           }
           tau += mp.sigma_t() * dt;

@@ -25,6 +25,7 @@
 
 #include "integrators/integrator.h"
 #include "integrators/shadow_map.h"
+#include "scene/lights.h"
 
 namespace nimbus {
 
@@ -49,6 +50,16 @@ class OctaveIntegrator final : public Integrator {
   nlohmann::json settings_json() const override { return to_json(s_); }
 
  private:
+  // One sample of every directional and point light at a march point, with its shadow-map transmittance.
+  struct LightSamples {
+    std::vector<LightSample> ls;
+    std::vector<Rgb> T;
+    std::vector<bool> ok;  // false: the light contributes nothing here
+  };
+  // What octave j (extinction scale bj = b^j) scatters towards the camera at p, per unit of a^j dt.
+  Rgb octave_scatter(int j, double bj, const Vec3& p, const Vec3& d, const MediumPoint& mp,
+                     const LightSamples& lights, Rng& rng) const;
+
   const SceneContext& ctx_;
   OctaveSettings s_;
   std::vector<std::vector<Phase>> phases_;  // [octave][medium]

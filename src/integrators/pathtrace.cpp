@@ -69,6 +69,37 @@ Rgb PathTracer::direct_light(const Vec3& p, const Vec3& d, int medium, int wide_
   return L;
 }
 
+bool PathTracer::collide(const MediumPoint& mp, double maj, Rgb& beta, Rng& rng, int* scatter_medium) const {
+  const Rgb sigma_n = Rgb(maj) - mp.sigma_t();
+  // Event probabilities from throughput-weighted channel sums (history-aware spectral tracking, which
+  // keeps the per-channel weights bounded); absorption is carried as weight, not sampled.
+  const double p_null = std::max(0.0, dot(beta, sigma_n));
+  double p_scatter = 0.0;
+  for (int i = 0; i < mp.count; ++i) p_scatter += dot(beta, mp.sigma_s_i[i]);
+  const double total = p_null + p_scatter;
+  if (total <= 0.0) {  // pure absorber at the majorant: the path ends here
+    beta = Rgb(0.0);
+    return true;
+  }
+  double u = rng.uniform() * total;
+  if (u < p_null) {
+    beta *= sigma_n * (total / (maj * p_null));
+    return false;
+  }
+  u -= p_null;
+  for (int i = 0; i < mp.count; ++i) {
+    const double pi = dot(beta, mp.sigma_s_i[i]);
+    if (pi <= 0.0) continue;
+    if (u < pi || i == mp.count - 1) {
+      beta *= mp.sigma_s_i[i] * (total / (maj * pi));
+      *scatter_medium = i;
+      return true;
+    }
+    u -= pi;
+  }
+  return true;
+}
+
 Rgb PathTracer::Li(const Ray& ray, Rng& rng) const {
   Rgb L(0.0), beta(1.0);
   Vec3 o = ray.o, d = ray.d;
@@ -81,35 +112,8 @@ Rgb PathTracer::Li(const Ray& ray, Rng& rng) const {
     const bool escaped = track(ctx_.majorants, o, d, std::numeric_limits<double>::infinity(), rng,
                                [&](const Vec3& p, double maj) {
                                  ctx_.media.eval(p, &mp);
-                                 const Rgb sigma_n = Rgb(maj) - mp.sigma_t();
-                                 // Event probabilities from throughput-weighted channel sums (history-aware
-                                 // spectral tracking, which keeps the per-channel weights bounded);
-                                 // absorption is carried as weight, not sampled.
-                                 const double p_null = std::max(0.0, dot(beta, sigma_n));
-                                 double p_scatter = 0.0;
-                                 for (int i = 0; i < mp.count; ++i) p_scatter += dot(beta, mp.sigma_s_i[i]);
-                                 const double total = p_null + p_scatter;
-                                 if (total <= 0.0) {  // pure absorber at the majorant: the path ends here
-                                   beta = Rgb(0.0);
-                                   return false;
-                                 }
-                                 double u = rng.uniform() * total;
-                                 if (u < p_null) {
-                                   beta *= sigma_n * (total / (maj * p_null));
-                                   return true;
-                                 }
-                                 u -= p_null;
-                                 for (int i = 0; i < mp.count; ++i) {
-                                   const double pi = dot(beta, mp.sigma_s_i[i]);
-                                   if (pi <= 0.0) continue;
-                                   if (u < pi || i == mp.count - 1) {
-                                     beta *= mp.sigma_s_i[i] * (total / (maj * pi));
-                                     scatter_medium = i;
-                                     scatter_p = p;
-                                     return false;
-                                   }
-                                   u -= pi;
-                                 }
+                                 if (!collide(mp, maj, beta, rng, &scatter_medium)) return true;
+                                 scatter_p = p;
                                  return false;
                                });
     if (escaped) {

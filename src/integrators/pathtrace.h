@@ -49,6 +49,11 @@ class PathTracer final : public Integrator {
   // Next-event estimate at a scattering vertex p of medium `medium`, the path travelling along d.
   // wide_scatters: wide scatters on the path so far (only used with a wide-scatter limit).
   Rgb direct_light(const Vec3& p, const Vec3& d, int medium, int wide_scatters, Rng& rng) const;
+  // One collision of delta tracking with the media at a point (mp) under majorant maj, by history-aware
+  // spectral tracking: updates the throughput beta. Returns false for a null collision (tracking goes
+  // on), true when the flight ends here: a real scatter in medium *scatter_medium, or the path absorbed
+  // (beta = 0, *scatter_medium untouched).
+  bool collide(const MediumPoint& mp, double maj, Rgb& beta, Rng& rng, int* scatter_medium) const;
   // The weight of a scatter into cosine mu in medium i for a path with `wide` wide scatters before it.
   double split_weight(int medium, double mu, int wide) const;
 
