@@ -1,0 +1,72 @@
+// An image says exactly how it was made: the resolved integrator block (overrides applied, "auto"
+// choices made) is in the result and the EXR header, and rendering the header's scene again gives the
+// same image.
+#include <gtest/gtest.h>
+
+#include <cstring>
+
+#include "nimbus/render.h"
+#include "support/scenes.h"
+
+namespace nimbus {
+namespace {
+
+std::string meta(const RenderResult& r, const std::string& key) {
+  for (const auto& [k, v] : r.metadata)
+    if (k == key) return v;
+  return "";
+}
+
+Scene sphere_scene(const std::string& integrator) {
+  return test::scene_from_json("{" + test::camera_json(8, 6) + R"(,
+    "media": [{"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1}, "sigma_s": 3.0, "sigma_a": 0.1,
+               "phase": {"type": "hg", "g": 0.8}}],
+    "lights": [{"type": "directional", "direction": [-1, 0.3, 0.2], "irradiance": 1.0},
+               {"type": "environment", "radiance": 0.2}],
+    "integrator": )" + integrator + "}");
+}
+
+TEST(RenderSettings, AutoChoicesAreResolvedInTheHeader) {
+  const Scene scene = sphere_scene(R"({"type": "mfs", "spp": 1, "photons": 4096, "beam_photons": 1024})");
+  const RenderResult r = render(scene);
+  ASSERT_TRUE(r.settings["scatter_grid_resolution"].is_number_integer());
+  EXPECT_GE(r.settings["scatter_grid_resolution"].get<int>(), 32);
+  EXPECT_LE(r.settings["scatter_grid_resolution"].get<int>(), 64);
+  EXPECT_EQ(r.settings["type"], "mfs");
+  EXPECT_EQ(r.settings["photons"], 4096);
+  EXPECT_EQ(meta(r, "nimbus/integrator_settings"), r.settings.dump());
+  const nlohmann::json rendered = nlohmann::json::parse(meta(r, "nimbus/scene"));
+  EXPECT_EQ(rendered["integrator"], r.settings);
+
+  // The header's scene renders the same image, bit for bit.
+  const Scene again = parse_scene(rendered, "header", ".");
+  const RenderResult r2 = render(again);
+  ASSERT_EQ(r2.image.rgb.size(), r.image.rgb.size());
+  EXPECT_EQ(std::memcmp(r2.image.rgb.data(), r.image.rgb.data(), r.image.rgb.size() * sizeof(float)), 0);
+  EXPECT_EQ(r2.settings, r.settings);
+}
+
+TEST(RenderSettings, OverridesAreWhatTheHeaderSays) {
+  const Scene scene = sphere_scene(R"({"type": "pathtrace", "spp": 2, "seed": 5, "max_wide_scatters": 1})");
+  RenderOptions o;
+  o.integrator = "single";
+  o.spp = 1;
+  const RenderResult r = render(scene, o);
+  // Another integrator starts from its own defaults; the scene's pathtrace fields do not follow it.
+  EXPECT_EQ(r.settings["type"], "single");
+  EXPECT_EQ(r.settings["spp"], 1);
+  EXPECT_EQ(r.settings["seed"], 5);
+  EXPECT_FALSE(r.settings.contains("max_wide_scatters"));
+  EXPECT_EQ(r.settings["tau_step"], 0.1);
+  EXPECT_EQ(nlohmann::json::parse(meta(r, "nimbus/scene"))["integrator"], r.settings);
+  EXPECT_EQ(meta(r, "nimbus/integrator"), "single");
+
+  // The same integrator keeps the scene's fields.
+  o.integrator = "pathtrace";
+  const RenderResult same = render(scene, o);
+  EXPECT_EQ(same.settings["max_wide_scatters"], 1);
+  EXPECT_EQ(same.settings["peak_fraction"], "auto");
+}
+
+}  // namespace
+}  // namespace nimbus
