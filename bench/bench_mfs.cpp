@@ -6,8 +6,8 @@
 
 #include <filesystem>
 
-#include "integrators/registry.h"
 #include "integrators/mfs.h"
+#include "integrators/registry.h"
 #include "nimbus/render.h"
 #include "nimbus/scene.h"
 
@@ -80,8 +80,7 @@ void BM_MfsCloudMemory(benchmark::State& state) {
   const nimbus::SceneContext ctx(scene);
   size_t grid_bytes = 0, beam_bytes = 0, total_bytes = 0;
   for (auto _ : state) {
-    const nimbus::MfsIntegrator mfs(ctx,
-                                    nimbus::mfs_settings_from_json(scene.integrator.options, "bench"));
+    const nimbus::MfsIntegrator mfs(ctx, nimbus::mfs_settings_from_json(scene.integrator.options, "bench"));
     grid_bytes = mfs.scatter_grid()->memory_bytes();
     beam_bytes = mfs.beam_grid() ? mfs.beam_grid()->memory_bytes() : 0;
     total_bytes = mfs.memory_bytes();

@@ -48,9 +48,9 @@ int main(int argc, char** argv) {
   using nanovdb::io::Codec;
   const auto grid = tiny_grid("density");
   const auto nano = nanovdb::openToNanoVDB<nanovdb::HostBuffer>(*grid, nanovdb::StatsMode::All,
-                                                                 nanovdb::ChecksumMode::Disable);
+                                                                nanovdb::ChecksumMode::Disable);
   const auto nano_sum = nanovdb::openToNanoVDB<nanovdb::HostBuffer>(*grid, nanovdb::StatsMode::All,
-                                                                     nanovdb::ChecksumMode::Full);
+                                                                    nanovdb::ChecksumMode::Full);
   write_vdb(data / "tiny.vdb", {grid});
   nanovdb::io::writeGrid((data / "tiny.nvdb").string(), nano, Codec::ZIP);
 

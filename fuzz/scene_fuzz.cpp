@@ -7,9 +7,8 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
-#include <string>
-
 #include <nlohmann/json.hpp>
+#include <string>
 
 #include "nimbus/error.h"
 #include "nimbus/scene.h"

@@ -9,9 +9,9 @@
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
-#include <new>
 #include <filesystem>
 #include <fstream>
+#include <new>
 #include <string>
 
 #include "io/vdb.h"

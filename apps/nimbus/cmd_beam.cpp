@@ -6,13 +6,13 @@
 //   angular     bins of polar angle [rad]; plane-integrated scattered radiance per sr per source photon
 //   radial      bins of radius [mfp]; forward scattered flux per unit area per source photon
 //   unscattered lo = hi = 0; unscattered flux through the plane
+#include <fmt/format.h>
+
 #include <cmath>
 #include <cstdio>
 #include <sstream>
 #include <string>
 #include <vector>
-
-#include <fmt/format.h>
 
 #include "commands.h"
 #include "io/atomic_file.h"
@@ -32,7 +32,6 @@ struct BeamArgs {
   bool n_given = false;
 };
 
-
 std::vector<std::string> split_names(const std::string& list) {
   std::vector<std::string> v;
   std::stringstream ss(list);
@@ -46,7 +45,8 @@ int run_beam(const BeamArgs& a) {
   BeamSettings s;
   s.phase = parse_phase_spec(a.phase);
   s.albedo = a.albedo;
-  if (!(a.albedo > 0.0 && a.albedo <= 1.0)) throw Error(fmt::format("--albedo must lie in (0, 1] (got {})", a.albedo));
+  if (!(a.albedo > 0.0 && a.albedo <= 1.0))
+    throw Error(fmt::format("--albedo must lie in (0, 1] (got {})", a.albedo));
   s.depths = parse_number_list("--depths", a.depths);
   if (a.geometry == "infinite") {
     if (a.n_given && a.n != 1.0) throw Error("--n needs --geometry slab:D");
@@ -70,7 +70,8 @@ int run_beam(const BeamArgs& a) {
   const std::vector<BeamRow> rows = beam_table(s, models);
   std::string text = "model,depth,quantity,lo,hi,value,stderr\n";
   for (const BeamRow& r : rows)
-    text += fmt::format("{},{:.9g},{},{:.9g},{:.9g},{:.9g},{:.9g}\n", r.model, r.depth, r.quantity, r.lo, r.hi, r.value, r.stderr_);
+    text += fmt::format("{},{:.9g},{},{:.9g},{:.9g},{:.9g},{:.9g}\n", r.model, r.depth, r.quantity, r.lo,
+                        r.hi, r.value, r.stderr_);
   if (a.out.empty() || a.out == "-") {
     std::fwrite(text.data(), 1, text.size(), stdout);
   } else {
@@ -88,12 +89,15 @@ int run_beam(const BeamArgs& a) {
 
 void add_beam_command(CLI::App& app, Action& action) {
   auto args = std::make_shared<BeamArgs>();
-  auto* cmd = app.add_subcommand("beam",
-                                 "Pencil beam into a scattering medium: photon Monte Carlo against the small-angle "
-                                 "propagators (lengths in scattering mean free paths)");
-  cmd->add_option("--phase", args->phase, "Phase function: iso, hg:G, dhg:G1,G2,W, gauss:THETA2, mie:NAME")->required();
+  auto* cmd =
+      app.add_subcommand("beam",
+                         "Pencil beam into a scattering medium: photon Monte Carlo against the small-angle "
+                         "propagators (lengths in scattering mean free paths)");
+  cmd->add_option("--phase", args->phase, "Phase function: iso, hg:G, dhg:G1,G2,W, gauss:THETA2, mie:NAME")
+      ->required();
   cmd->add_option("--albedo", args->albedo, "Single-scattering albedo b/c in (0, 1]")->required();
-  cmd->add_option("--depths", args->depths, "Optical depths b z of the tally planes, comma-separated")->required();
+  cmd->add_option("--depths", args->depths, "Optical depths b z of the tally planes, comma-separated")
+      ->required();
   cmd->add_option("--geometry", args->geometry, "infinite (default) or slab:D (D in mean free paths)");
   auto* n_opt = cmd->add_option("--n", args->n, "Refractive index of the slab against 1 outside (default 1)");
   cmd->add_option("--photons", args->photons, "Monte Carlo photons (default 1e6)");

@@ -60,7 +60,8 @@ void add_compare_command(CLI::App& app, Action& action) {
   auto* cmd = app.add_subcommand("compare", "Compare an EXR image against a reference EXR");
   cmd->add_option("a", args->a, "Test image (EXR)")->required();
   cmd->add_option("b", args->b, "Reference image (EXR)")->required();
-  cmd->add_option("--bin", args->bin, "Bin k x k pixels before the per-bin metrics")->check(CLI::Range(1, 1 << 16));
+  cmd->add_option("--bin", args->bin, "Bin k x k pixels before the per-bin metrics")
+      ->check(CLI::Range(1, 1 << 16));
   cmd->add_option("--min-ref", args->min_ref,
                   "Exclude bins whose reference luminance is below this fraction of the mean")
       ->check(CLI::Range(0.0, 1e6));

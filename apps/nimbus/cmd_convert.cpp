@@ -29,7 +29,8 @@ void add_convert_command(CLI::App& app, Action& action) {
   auto* cmd = app.add_subcommand("convert", "Convert an EXR image to PNG (sRGB, with exposure) or EXR");
   cmd->add_option("input", args->input, "Input image (EXR)")->required();
   cmd->add_option("output", args->output, "Output image: .png (sRGB) or .exr")->required();
-  cmd->add_option("--exposure", args->exposure, "Exposure in stops for PNG output")->check(CLI::Range(-64.0, 64.0));
+  cmd->add_option("--exposure", args->exposure, "Exposure in stops for PNG output")
+      ->check(CLI::Range(-64.0, 64.0));
   cmd->callback([args, &action] { action = [args] { return run_convert(*args); }; });
 }
 

@@ -1,9 +1,9 @@
 // nimbus render [SCENE.json] -o OUT.exr|OUT.png: renders a scene (the built-in demo without one).
+#include <fmt/format.h>
+
 #include <csignal>
 #include <filesystem>
 #include <optional>
-
-#include <fmt/format.h>
 
 #include "commands.h"
 #include "nimbus/error.h"
@@ -72,7 +72,9 @@ int run_render(const RenderArgs& args) {
   options.cancel = &g_cancel;
   ProgressBar bar(fmt::format("nimbus: {}", args.scene.empty() ? "demo" : args.scene),
                   !args.quiet && stderr_is_terminal());
-  options.progress = [&bar](int64_t done, int64_t total, int64_t samples) { bar.update(done, total, samples); };
+  options.progress = [&bar](int64_t done, int64_t total, int64_t samples) {
+    bar.update(done, total, samples);
+  };
 
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
@@ -110,14 +112,16 @@ void add_render_command(CLI::App& app, Action& action) {
   cmd->add_option("-o,--output", args->output, "Output image: .exr (linear float RGB) or .png (sRGB preview)")
       ->required();
   cmd->add_option("--preview", args->preview, "Also write an sRGB PNG preview of the same render");
-  cmd->add_option("--spp", args->spp, "Samples per pixel (overrides the scene)")->check(CLI::Range(1, kMaxSpp));
+  cmd->add_option("--spp", args->spp, "Samples per pixel (overrides the scene)")
+      ->check(CLI::Range(1, kMaxSpp));
   cmd->add_option("--threads", args->threads, "Worker threads (0 = all cores)")->check(CLI::Range(0, 4096));
   cmd->add_option("--seed", args->seed, "Random seed (overrides the scene)");
   std::string names;
   for (const std::string& n : integrator_names()) names += (names.empty() ? "" : ", ") + n;
   cmd->add_option("--integrator", args->integrator, "Integrator (overrides the scene): " + names)
       ->check(CLI::IsMember(integrator_names()));
-  cmd->add_option("--exposure", args->exposure, "Exposure in stops for PNG output")->check(CLI::Range(-64.0, 64.0));
+  cmd->add_option("--exposure", args->exposure, "Exposure in stops for PNG output")
+      ->check(CLI::Range(-64.0, 64.0));
   cmd->add_flag("-q,--quiet", args->quiet, "No progress bar or summary");
   cmd->callback([args, &action] { action = [args] { return run_render(*args); }; });
 }

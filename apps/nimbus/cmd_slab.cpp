@@ -4,12 +4,12 @@
 // --csv [FILE] adds angle- and radius-resolved reflectance and transmittance (to FILE or stdout):
 //   side,quantity,lo,hi,value,stderr   side = reflect|transmit, quantity = angular (per sr of exit
 //   solid angle, exit polar angle outside the slab, rad) or radial (per unit area, exit radius).
+#include <fmt/format.h>
+
 #include <cmath>
 #include <cstdio>
 #include <string>
 #include <vector>
-
-#include <fmt/format.h>
 
 #include "commands.h"
 #include "core/math.h"
@@ -31,15 +31,19 @@ struct SlabArgs {
 };
 
 int run_slab(const SlabArgs& a) {
-  if (!(a.mu_s >= 0.0) || !std::isfinite(a.mu_s)) throw Error(fmt::format("--mu-s must be >= 0 (got {})", a.mu_s));
-  if (!(a.mu_a >= 0.0) || !std::isfinite(a.mu_a)) throw Error(fmt::format("--mu-a must be >= 0 (got {})", a.mu_a));
+  if (!(a.mu_s >= 0.0) || !std::isfinite(a.mu_s))
+    throw Error(fmt::format("--mu-s must be >= 0 (got {})", a.mu_s));
+  if (!(a.mu_a >= 0.0) || !std::isfinite(a.mu_a))
+    throw Error(fmt::format("--mu-a must be >= 0 (got {})", a.mu_a));
   // Each finite, their sum (the extinction) may still overflow: 1e308 + 1e308 made an infinite
   // sigma_t and a slab that reflected everything.
   if (!std::isfinite(a.mu_s + a.mu_a))
     throw Error(fmt::format("--mu-s + --mu-a must be finite (got {} + {})", a.mu_s, a.mu_a));
   if (!(a.g > -1.0 && a.g < 1.0)) throw Error(fmt::format("--g must lie in (-1, 1) (got {})", a.g));
-  if (!(a.thickness > 0.0) || !std::isfinite(a.thickness)) throw Error(fmt::format("--thickness must be > 0 (got {})", a.thickness));
-  if (!(a.n >= 1.0) || !std::isfinite(a.n) || a.n > 10.0) throw Error(fmt::format("--n must lie in [1, 10] (got {})", a.n));
+  if (!(a.thickness > 0.0) || !std::isfinite(a.thickness))
+    throw Error(fmt::format("--thickness must be > 0 (got {})", a.thickness));
+  if (!(a.n >= 1.0) || !std::isfinite(a.n) || a.n > 10.0)
+    throw Error(fmt::format("--n must lie in [1, 10] (got {})", a.n));
   if (!(a.photons >= 20.0) || a.photons > 1e12 || a.photons != std::floor(a.photons))
     throw Error("--photons must be a whole number >= 20");
   if (a.angle_bins < 1 || a.r_bins < 1) throw Error("--angle-bins and --r-bins must be >= 1");
@@ -54,12 +58,15 @@ int run_slab(const SlabArgs& a) {
   s.batches = 20;
   for (int i = 0; i <= a.angle_bins; ++i) s.theta_edges.push_back(0.5 * kPi * i / a.angle_bins);
   const double transport = a.mu_a + a.mu_s * (1.0 - a.g);
-  const double r_max = a.r_max > 0.0 ? a.r_max : 5.0 * std::max(a.thickness, transport > 0.0 ? 1.0 / transport : a.thickness);
+  const double r_max =
+      a.r_max > 0.0 ? a.r_max : 5.0 * std::max(a.thickness, transport > 0.0 ? 1.0 / transport : a.thickness);
   for (int i = 0; i <= a.r_bins; ++i) s.r_edges.push_back(r_max * i / a.r_bins);
   const PhotonMcResult r = run_photon_mc(s);
 
   std::string text;
-  auto line = [&](const char* name, const Estimate& e) { text += fmt::format("{} {:.8g} {:.3g}\n", name, e.value, e.err); };
+  auto line = [&](const char* name, const Estimate& e) {
+    text += fmt::format("{} {:.8g} {:.3g}\n", name, e.value, e.err);
+  };
   line("specular", r.specular);
   line("diffuse_reflectance", r.diffuse_reflectance);
   line("transmittance", r.transmittance);
@@ -69,9 +76,11 @@ int run_slab(const SlabArgs& a) {
   if (!a.csv) return kExitOk;
 
   std::string csv = "side,quantity,lo,hi,value,stderr\n";
-  auto rows = [&](const char* side, const char* q, const std::vector<double>& edges, const std::vector<Estimate>& v) {
+  auto rows = [&](const char* side, const char* q, const std::vector<double>& edges,
+                  const std::vector<Estimate>& v) {
     for (size_t i = 0; i < v.size(); ++i)
-      csv += fmt::format("{},{},{:.9g},{:.9g},{:.9g},{:.9g}\n", side, q, edges[i], edges[i + 1], v[i].value, v[i].err);
+      csv += fmt::format("{},{},{:.9g},{:.9g},{:.9g},{:.9g}\n", side, q, edges[i], edges[i + 1], v[i].value,
+                         v[i].err);
   };
   rows("reflect", "angular", s.theta_edges, r.reflect_angular);
   rows("reflect", "radial", s.r_edges, r.reflect_radial);
@@ -106,8 +115,10 @@ void add_slab_command(CLI::App& app, Action& action) {
   cmd->add_option("--seed", args->seed, "Random seed (default 1)");
   cmd->add_option("--angle-bins", args->angle_bins, "Exit-angle bins over [0, pi/2] for --csv (default 30)");
   cmd->add_option("--r-bins", args->r_bins, "Exit-radius bins for --csv (default 50)");
-  cmd->add_option("--r-max", args->r_max, "Largest exit radius for --csv (default 5 transport lengths or 5 D)");
-  auto* csv = cmd->add_option("--csv", args->csv_path, "Also write angle- and radius-resolved tallies (to FILE, or stdout)")
+  cmd->add_option("--r-max", args->r_max,
+                  "Largest exit radius for --csv (default 5 transport lengths or 5 D)");
+  auto* csv = cmd->add_option("--csv", args->csv_path,
+                              "Also write angle- and radius-resolved tallies (to FILE, or stdout)")
                   ->expected(0, 1);
   cmd->callback([args, csv, &action] {
     args->csv = csv->count() > 0;

@@ -3,9 +3,8 @@
 // nimbus::Error into a message on stderr and exit code 2.
 #pragma once
 
-#include <functional>
-
 #include <CLI/CLI.hpp>
+#include <functional>
 
 namespace nimbus::cli {
 
@@ -23,7 +22,7 @@ void add_slab_command(CLI::App& app, Action& action);
 
 // Exit codes.
 inline constexpr int kExitOk = 0;
-inline constexpr int kExitFailure = 1;    // the run itself failed (I/O error writing, cancelled)
-inline constexpr int kExitBadInput = 2;   // bad arguments, scene, volume or image
+inline constexpr int kExitFailure = 1;   // the run itself failed (I/O error writing, cancelled)
+inline constexpr int kExitBadInput = 2;  // bad arguments, scene, volume or image
 
 }  // namespace nimbus::cli

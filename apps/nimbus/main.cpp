@@ -1,8 +1,8 @@
 // nimbus: the command-line front end. The only code that prints or exits.
+#include <fmt/format.h>
+
 #include <cstdio>
 #include <exception>
-
-#include <fmt/format.h>
 
 #include "commands.h"
 #include "nimbus/error.h"

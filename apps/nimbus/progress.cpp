@@ -1,10 +1,9 @@
 #include "progress.h"
 
+#include <fmt/format.h>
 #include <unistd.h>
 
 #include <cstdio>
-
-#include <fmt/format.h>
 
 namespace nimbus::cli {
 
@@ -24,8 +23,8 @@ void ProgressBar::update(int64_t done, int64_t total, int64_t samples) {
   const int width = 30, filled = int(frac * width);
   const double rate = elapsed > 0 ? samples / elapsed : 0.0;
   const double eta = frac > 0 ? elapsed * (1.0 - frac) / frac : 0.0;
-  fmt::print(stderr, "\r{} [{}{}] {:5.1f}%  {:.3g} samples/s  ETA {:.0f}s   ", label_, std::string(filled, '#'),
-             std::string(width - filled, '.'), 100.0 * frac, rate, eta);
+  fmt::print(stderr, "\r{} [{}{}] {:5.1f}%  {:.3g} samples/s  ETA {:.0f}s   ", label_,
+             std::string(filled, '#'), std::string(width - filled, '.'), 100.0 * frac, rate, eta);
   std::fflush(stderr);
   drawn_ = true;
 }

@@ -13,7 +13,7 @@
 namespace nimbus {
 
 struct CompareOptions {
-  int bin = 1;                // k x k box binning before the per-bin metrics
+  int bin = 1;                 // k x k box binning before the per-bin metrics
   double min_reference = 0.0;  // fraction of the mean reference luminance below which bins are excluded
 };
 

@@ -13,12 +13,12 @@
 namespace nimbus {
 
 struct RenderOptions {
-  std::optional<int> spp;               // overrides the scene's integrator.spp
-  std::optional<uint64_t> seed;         // overrides integrator.seed
+  std::optional<int> spp;        // overrides the scene's integrator.spp
+  std::optional<uint64_t> seed;  // overrides integrator.seed
   // Overrides integrator.type; another integrator than the scene's starts from its own defaults (the
   // scene's integrator fields belong to the integrator it names).
   std::optional<std::string> integrator;
-  int threads = 0;                      // 0 = all hardware threads
+  int threads = 0;  // 0 = all hardware threads
   int tile_size = 16;
   // Called from worker threads as tiles finish: (tiles done, tiles total, samples so far).
   std::function<void(int64_t done, int64_t total, int64_t samples)> progress;
@@ -28,7 +28,7 @@ struct RenderOptions {
 
 struct RenderResult {
   Image image;
-  bool partial = false;           // cancelled: tiles not rendered are black
+  bool partial = false;  // cancelled: tiles not rendered are black
   int64_t tiles_done = 0, tiles_total = 0;
   int64_t nonfinite_samples = 0;  // NaN/inf samples found and dropped by the film
   double seconds = 0.0;

@@ -5,11 +5,10 @@
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <variant>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "nimbus/phase.h"
 #include "nimbus/types.h"
@@ -49,7 +48,7 @@ struct CloudShape {
   Vec3 center{0, 0, 0};
   double radius = 1.0;  // overall size
   uint32_t seed = 1;
-  int resolution = 128;  // voxels along the longest axis
+  int resolution = 128;                     // voxels along the longest axis
   std::shared_ptr<const DensityGrid> data;  // built by load_scene
 };
 using Shape = std::variant<SphereShape, BoxShape, VdbShape, CloudShape>;

@@ -1,8 +1,8 @@
 #include "core/json_reader.h"
 
-#include <cmath>
-
 #include <fmt/format.h>
+
+#include <cmath>
 
 #include "nimbus/error.h"
 
@@ -218,8 +218,8 @@ bool JsonObject::keyword_or_number(const std::string& key, const std::string& ke
   return true;
 }
 
-bool JsonObject::keyword_or_integer(const std::string& key, const std::string& keyword, int64_t lo, int64_t hi,
-                                    int64_t* value) {
+bool JsonObject::keyword_or_integer(const std::string& key, const std::string& keyword, int64_t lo,
+                                    int64_t hi, int64_t* value) {
   if (!has(key)) {
     used_.insert(key);
     return false;

@@ -2,12 +2,11 @@
 // every error a nimbus::Error "FILE: /json/pointer: message".
 #pragma once
 
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <set>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "core/math.h"
 
@@ -42,7 +41,8 @@ class JsonObject {
   int choice(const std::string& key, const std::vector<std::string>& names, int fallback);
   // Either the string `keyword` (returns false: the caller keeps its "auto"-like default) or a number in
   // [lo, hi] written to *value (returns true). Message: must be "keyword" or a number in [lo, hi].
-  bool keyword_or_number(const std::string& key, const std::string& keyword, double lo, double hi, double* value);
+  bool keyword_or_number(const std::string& key, const std::string& keyword, double lo, double hi,
+                         double* value);
   bool keyword_or_integer(const std::string& key, const std::string& keyword, int64_t lo, int64_t hi,
                           int64_t* value);
   Vec3 vec3(const std::string& key);

@@ -24,9 +24,7 @@ inline double min_component(const Rgb& c) { return std::min({c.x, c.y, c.z}); }
 inline double average(const Rgb& c) { return (c.x + c.y + c.z) / 3.0; }
 inline double luminance(const Rgb& c) { return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z; }
 inline Rgb exp(const Rgb& c) { return {std::exp(c.x), std::exp(c.y), std::exp(c.z)}; }
-inline bool is_finite(const Rgb& c) {
-  return std::isfinite(c.x) && std::isfinite(c.y) && std::isfinite(c.z);
-}
+inline bool is_finite(const Rgb& c) { return std::isfinite(c.x) && std::isfinite(c.y) && std::isfinite(c.z); }
 
 // An orthonormal frame (s, t, n) around a unit vector n (Duff et al. 2017, branchless).
 struct Frame {
@@ -58,7 +56,10 @@ struct Bounds {
     hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
   }
   void extend(const Bounds& b) {
-    if (!b.empty()) { extend(b.lo); extend(b.hi); }
+    if (!b.empty()) {
+      extend(b.lo);
+      extend(b.hi);
+    }
   }
   bool overlaps(const Bounds& b) const {
     return lo.x <= b.hi.x && b.lo.x <= hi.x && lo.y <= b.hi.y && b.lo.y <= hi.y && lo.z <= b.hi.z &&

@@ -17,7 +17,8 @@ constexpr double kRoulette = 0.05;  // roulette below this ratio of weight to T_
 
 // Adds v (channel ch) with trilinear weights st to the tally: to the straight column, or to the traced
 // one and (times mu) the traced x cosine one.
-void splat(std::vector<float>& tally, const TrilinearStencil& st, int ch, double v, double mu, bool straight) {
+void splat(std::vector<float>& tally, const TrilinearStencil& st, int ch, double v, double mu,
+           bool straight) {
   for (int j = 0; j < 8; ++j)
     if (st.weight[j] > 0.0) {
       float* node = &tally[st.node[j] * kFloats];
@@ -52,7 +53,7 @@ struct BeamPhotons {
   Vec3 dir_w;               // a directional light's direction of travel
   bool grey;                // one pass carrying RGB (else one pass per channel)
   size_t per_light;
-  Vec3 centre;              // of the node grid's bounding sphere, which the photons are aimed at
+  Vec3 centre;  // of the node grid's bounding sphere, which the photons are aimed at
   double radius;
 
   void trace(size_t j, Rng& rng, PhotonBatch& batch) const;
@@ -160,8 +161,9 @@ bool BeamPhotons::scatter(const Vec3& xc, Vec3* w, BeamWalk& walk, Rng& rng, Pho
 }  // namespace
 
 BeamGrid::BeamGrid(const SceneContext& ctx, const std::vector<const PhaseSplit*>& splits,
-                   const std::vector<double>& peak_fraction, const std::vector<TransmittanceGrid>& reduced_maps,
-                   int photons, int resolution, uint64_t seed) {
+                   const std::vector<double>& peak_fraction,
+                   const std::vector<TransmittanceGrid>& reduced_maps, int photons, int resolution,
+                   uint64_t seed) {
   values_.resize(ctx.lights.size());
   const Bounds media_bounds = ctx.media.bounds();
   if (media_bounds.empty() || photons <= 0 || reduced_maps.size() != ctx.lights.size()) return;

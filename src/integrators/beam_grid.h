@@ -42,7 +42,7 @@ class BeamGrid {
   uint64_t rejection_failures() const { return rejection_failures_; }
 
  private:
-  NodeGrid grid_;  // the media's bounds padded by one spacing (node_grid_padded)
+  NodeGrid grid_;                           // the media's bounds padded by one spacing (node_grid_padded)
   std::vector<std::vector<float>> values_;  // per light and node: traced, traced x cosine, straight (rgb)
   uint64_t rejection_failures_ = 0;
 };

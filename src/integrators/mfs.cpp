@@ -2,9 +2,9 @@
 
 #include <fmt/format.h>
 
+#include "core/json_reader.h"
 #include "integrators/mfs_estimators.h"
 #include "integrators/tracking.h"
-#include "core/json_reader.h"
 #include "nimbus/error.h"
 
 namespace nimbus {
@@ -24,7 +24,8 @@ MfsSettings mfs_settings_from_json(const nlohmann::json& options, const std::str
   s.light_path = LightPath(o.choice("light_path", kLightPathNames, int(s.light_path)));
   s.propagator = Propagator(o.choice("propagator", kPropagatorNames, int(s.propagator)));
   if (double f = 0.0; o.keyword_or_number("peak_fraction", "auto", 0.0, 0.99, &f)) s.peak_fraction = f;
-  if (int64_t k = 0; o.keyword_or_integer("large_angle_scatters", "all", 0, 1024, &k)) s.large_angle_scatters = int(k);
+  if (int64_t k = 0; o.keyword_or_integer("large_angle_scatters", "all", 0, 1024, &k))
+    s.large_angle_scatters = int(k);
   s.photons = int(o.integer("photons", 1, 1 << 26, s.photons));
   s.photon_transport =
       PhotonTransport(o.choice("photon_transport", kPhotonTransportNames, int(s.photon_transport)));
@@ -190,7 +191,7 @@ MfsIntegrator::MediumRadiance MfsIntegrator::medium_radiance(int i, const Vec3& 
     }
     if (s_.large_angle_scatters != 0)  // eq. D7, first term
       out.L += first_wide_scatter(ls.weight, f, split, mu, y.tau_p, s_.light_blur ? beam.tau_ps : Rgb(0.0),
-                                 beam.T_wide);
+                                  beam.T_wide);
     if (s_.forward_light_path())  // eq. D7, second term: to the camera with T_full
       out.L_peak += forward_peak(ls.weight, f, split, mu, beam.tau_ps, beam.T_wide);
     else  // eq. D7b (beer_lambert)

@@ -74,8 +74,8 @@ struct MfsSettings {
   double step_growth = 1.0;
   LightPath light_path = LightPath::forward;
   Propagator propagator = Propagator::gsa;
-  std::optional<double> peak_fraction;        // nullopt: "auto"
-  std::optional<int> large_angle_scatters;    // nullopt: "all"
+  std::optional<double> peak_fraction;      // nullopt: "auto"
+  std::optional<int> large_angle_scatters;  // nullopt: "all"
   int photons = 1 << 18;
   PhotonTransport photon_transport = PhotonTransport::exact;
   std::optional<int> scatter_grid_resolution;  // nullopt: "auto" (resolved by MfsIntegrator)

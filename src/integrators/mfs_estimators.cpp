@@ -75,13 +75,14 @@ LightBeam peak_only_beam(const Rgb& T_light, const Rgb& T_wide, bool traced, con
       // eq. D9: the traced beam's loss R, and the peak depth whose spread has its mean cosine (eq. D3
       // at l = 1: mean_cos = exp(-tau_ps (1 - chi_1^peak))).
       b.T_wide[c] *= R[c];
-      b.tau_ps[c] = one_minus_chi1 > 0.0
-                        ? std::min(PhaseSplit::kTauMax, -std::log(std::max(mean_cos[c], 1e-12)) / one_minus_chi1)
-                        : 0.0;
+      b.tau_ps[c] = one_minus_chi1 > 0.0 ? std::min(PhaseSplit::kTauMax,
+                                                    -std::log(std::max(mean_cos[c], 1e-12)) / one_minus_chi1)
+                                         : 0.0;
       continue;
     }
     // eq. D8: the straight beam's peak depth ln(T_wide / T_light), and optionally eq. D5.
-    b.tau_ps[c] = T_light[c] > 1e-30 ? std::max(0.0, std::log(b.T_wide[c] / T_light[c])) : PhaseSplit::kTauMax;
+    b.tau_ps[c] =
+        T_light[c] > 1e-30 ? std::max(0.0, std::log(b.T_wide[c] / T_light[c])) : PhaseSplit::kTauMax;
     if (lengthening && b.T_wide[c] > 0.0)
       b.T_wide[c] *= path_lengthening(theta2 * b.tau_ps[c], -std::log(b.T_wide[c]));
   }
@@ -113,7 +114,9 @@ Rgb light_side_scatter(const Rgb& E, double f, const PhaseSplit& split, double m
 }
 
 namespace {
-double moment(const std::vector<double>& m, int l, double fallback) { return int(m.size()) > l ? m[l] : fallback; }
+double moment(const std::vector<double>& m, int l, double fallback) {
+  return int(m.size()) > l ? m[l] : fallback;
+}
 }  // namespace
 
 std::array<Rgb, kShMaxBands> blurred_wide_moments(const PhaseSplit& split, const Rgb& tau_p, int bands) {
@@ -122,7 +125,8 @@ std::array<Rgb, kShMaxBands> blurred_wide_moments(const PhaseSplit& split, const
   const std::vector<double>& chi_p = split.peak_moments();
   std::array<Rgb, kShMaxBands> chi{};
   for (int l = 0; l < bands; ++l)
-    for (int c = 0; c < 3; ++c) chi[l][c] = moment(chi_w, l, 0.0) * std::exp(-tau_p[c] * (1.0 - moment(chi_p, l, 1.0)));
+    for (int c = 0; c < 3; ++c)
+      chi[l][c] = moment(chi_w, l, 0.0) * std::exp(-tau_p[c] * (1.0 - moment(chi_p, l, 1.0)));
   return chi;
 }
 

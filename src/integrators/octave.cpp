@@ -2,9 +2,9 @@
 
 #include <cmath>
 
+#include "core/json_reader.h"
 #include "integrators/tracking.h"
 #include "media/phase.h"
-#include "core/json_reader.h"
 #include "scene/lights.h"
 
 namespace nimbus {
@@ -23,8 +23,12 @@ OctaveSettings octave_settings_from_json(const nlohmann::json& options, const st
 }
 
 nlohmann::json to_json(const OctaveSettings& s) {
-  return {{"octaves", s.octaves}, {"a", s.a},     {"b", s.b},
-          {"c", s.c},             {"tau_step", s.tau_step}, {"shadow_map_resolution", s.shadow_map_resolution}};
+  return {{"octaves", s.octaves},
+          {"a", s.a},
+          {"b", s.b},
+          {"c", s.c},
+          {"tau_step", s.tau_step},
+          {"shadow_map_resolution", s.shadow_map_resolution}};
 }
 
 Phase scale_phase_eccentricity(const Phase& phase, double scale) {
@@ -73,8 +77,8 @@ Rgb OctaveIntegrator::octave_scatter(int j, double bj, const Vec3& p, const Vec3
     if (ctx_.has_environment) {
       const double u1 = rng.uniform(), u2 = rng.uniform();
       const Vec3 wi = phase_sample(phase, d, u1, u2);
-      const Rgb T = marched_transmittance(ctx_.media, ctx_.majorants, p, wi, std::numeric_limits<double>::infinity(),
-                                          0.25 / std::max(bj, 0.05));
+      const Rgb T = marched_transmittance(ctx_.media, ctx_.majorants, p, wi,
+                                          std::numeric_limits<double>::infinity(), 0.25 / std::max(bj, 0.05));
       Rgb Tb;
       for (int c = 0; c < 3; ++c) Tb[c] = std::pow(std::max(T[c], 1e-300), bj);
       Li += ctx_.environment * Tb;

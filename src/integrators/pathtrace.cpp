@@ -1,7 +1,7 @@
 #include "integrators/pathtrace.h"
 
-#include "integrators/tracking.h"
 #include "core/json_reader.h"
+#include "integrators/tracking.h"
 #include "scene/lights.h"
 
 namespace nimbus {

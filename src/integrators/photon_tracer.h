@@ -22,7 +22,7 @@
 
 namespace nimbus {
 
-inline constexpr int kPhotonBatches = 8;  // fixed: the grids must not depend on the thread count
+inline constexpr int kPhotonBatches = 8;          // fixed: the grids must not depend on the thread count
 inline constexpr int kMaxPhotonEvents = 1 << 14;  // photons are ended after this many real collisions
 // Work budget: a batch stops starting photons once its collisions exceed this many per photon of the
 // batch, and its deposits are scaled by planned / traced photons (optically very thick media would
@@ -48,9 +48,9 @@ bool grey_media(const SceneContext& ctx);
 
 // What one batch of photons has written and spent.
 struct PhotonBatch {
-  std::vector<float> tally;           // the grid's per-node sums, laid out as the grid wants
-  double collisions = 0.0;            // real collisions so far (the work budget's measure)
-  uint64_t rejection_failures = 0;    // scatters whose direction sample_by_rejection could not draw
+  std::vector<float> tally;         // the grid's per-node sums, laid out as the grid wants
+  double collisions = 0.0;          // real collisions so far (the work budget's measure)
+  uint64_t rejection_failures = 0;  // scatters whose direction sample_by_rejection could not draw
 };
 
 // Traces photons j = 0 .. total - 1, each with its own stream Rng(stream_seed, j), by

@@ -30,11 +30,13 @@ IntegratorEntry entry(std::string name, std::string summary,
 
 std::vector<IntegratorEntry> make_registry() {
   std::vector<IntegratorEntry> r;
-  r.push_back(entry("pathtrace", "the reference: unbiased volumetric path tracing", &pathtrace_settings_from_json,
+  r.push_back(entry("pathtrace", "the reference: unbiased volumetric path tracing",
+                    &pathtrace_settings_from_json,
                     [](const SceneContext& c, PathTraceSettings s, const IntegratorSettings& common) {
                       return std::make_unique<PathTracer>(c, common.max_events, s);
                     }));
-  r.push_back(entry("single", "unscattered plus single-scattered light by a ray march", &single_settings_from_json,
+  r.push_back(entry("single", "unscattered plus single-scattered light by a ray march",
+                    &single_settings_from_json,
                     [](const SceneContext& c, SingleSettings s, const IntegratorSettings&) {
                       return std::make_unique<SingleScatter>(c, s);
                     }));
@@ -43,10 +45,11 @@ std::vector<IntegratorEntry> make_registry() {
                     [](const SceneContext& c, MfsSettings s, const IntegratorSettings& common) {
                       return std::make_unique<MfsIntegrator>(c, s, common.seed);
                     }));
-  r.push_back(entry("octave", "the production baseline of Wrenninge et al. 2013 (octaves of single scattering)",
-                    &octave_settings_from_json, [](const SceneContext& c, OctaveSettings s, const IntegratorSettings&) {
-                      return std::make_unique<OctaveIntegrator>(c, s);
-                    }));
+  r.push_back(entry(
+      "octave", "the production baseline of Wrenninge et al. 2013 (octaves of single scattering)",
+      &octave_settings_from_json, [](const SceneContext& c, OctaveSettings s, const IntegratorSettings&) {
+        return std::make_unique<OctaveIntegrator>(c, s);
+      }));
   return r;
 }
 
@@ -69,7 +72,8 @@ std::vector<std::string> integrator_names() {
   return names;
 }
 
-void validate_integrator_options(const std::string& type, const nlohmann::json& options, const std::string& where) {
+void validate_integrator_options(const std::string& type, const nlohmann::json& options,
+                                 const std::string& where) {
   find_integrator(type).validate(options, where);
 }
 

@@ -6,10 +6,9 @@
 
 #include <functional>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "integrators/integrator.h"
 #include "nimbus/scene.h"
@@ -34,7 +33,8 @@ const std::vector<IntegratorEntry>& integrator_registry();
 const IntegratorEntry& find_integrator(const std::string& name);
 
 // Shorthands for the two calls through the registry.
-void validate_integrator_options(const std::string& type, const nlohmann::json& options, const std::string& where);
+void validate_integrator_options(const std::string& type, const nlohmann::json& options,
+                                 const std::string& where);
 std::unique_ptr<Integrator> make_integrator(const SceneContext& context, const IntegratorSettings& settings,
                                             const std::string& where = "scene");
 

@@ -53,7 +53,8 @@ void deposit_flight(std::vector<float>& tally, const NodeGrid& grid, int bands, 
 
 // The next pre-filtered level: the values (`floats` per node) of `fine` at its nodes 2j, filtered with
 // the tent (1/4, 1/2, 1/4) per axis, on `coarse` (nodes beyond fine's last are clamped to it).
-std::vector<float> tent_downsample(const NodeGrid& fine, const float* src, const NodeGrid& coarse, int floats) {
+std::vector<float> tent_downsample(const NodeGrid& fine, const float* src, const NodeGrid& coarse,
+                                   int floats) {
   std::vector<float> values(coarse.size() * floats, 0.0f);
   const std::array<int, 3> nb = fine.nodes;
   auto at = [&](int x, int y, int z) {
@@ -85,15 +86,16 @@ struct ScatterPhotons {
   const ScatterGridSettings& s;
   const NodeGrid& grid;
   int bands;
-  bool grey;              // one pass carrying RGB power (else one pass per channel)
-  size_t lights;          // light sources (then the environment, if any)
+  bool grey;      // one pass carrying RGB power (else one pass per channel)
+  size_t lights;  // light sources (then the environment, if any)
   size_t sources, per_source;
-  Vec3 centre;            // of the media's bounding sphere, which the photons are aimed at
+  Vec3 centre;  // of the media's bounding sphere, which the photons are aimed at
   double radius;
-  int K;                  // flights after wide scatter 1 .. K - 1 are kept
+  int K;  // flights after wide scatter 1 .. K - 1 are kept
 
   void trace(size_t j, Rng& rng, PhotonBatch& batch) const;
-  bool scatter(const Vec3& xc, Vec3* w, int c, double* weight, int* order, Rng& rng, PhotonBatch& batch) const;
+  bool scatter(const Vec3& xc, Vec3* w, int c, double* weight, int* order, Rng& rng,
+               PhotonBatch& batch) const;
 };
 
 void ScatterPhotons::trace(size_t j, Rng& rng, PhotonBatch& batch) const {

@@ -1,8 +1,8 @@
 #include "integrators/single.h"
 
+#include "core/json_reader.h"
 #include "integrators/tracking.h"
 #include "media/phase.h"
-#include "core/json_reader.h"
 #include "scene/lights.h"
 
 namespace nimbus {

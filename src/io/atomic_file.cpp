@@ -2,13 +2,12 @@
 #include "io/atomic_file.h"
 
 #include <fcntl.h>
+#include <fmt/format.h>
 #include <unistd.h>
 
 #include <atomic>
 #include <cerrno>
 #include <cstring>
-
-#include <fmt/format.h>
 
 #include "nimbus/error.h"
 
@@ -60,7 +59,8 @@ void atomic_write_bytes(const fs::path& path, const std::string& bytes) {
       ::close(fd);
       throw Error(fmt::format("{}: cannot write: {}", path.string(), std::strerror(err)));
     }
-    if (::close(fd) != 0) throw Error(fmt::format("{}: cannot write: {}", path.string(), std::strerror(errno)));
+    if (::close(fd) != 0)
+      throw Error(fmt::format("{}: cannot write: {}", path.string(), std::strerror(errno)));
   });
 }
 

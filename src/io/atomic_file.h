@@ -8,7 +8,8 @@
 
 namespace nimbus {
 
-void atomic_write(const std::filesystem::path& path, const std::function<void(const std::filesystem::path& tmp)>& writer);
+void atomic_write(const std::filesystem::path& path,
+                  const std::function<void(const std::filesystem::path& tmp)>& writer);
 // Writes bytes through atomic_write, checking every write and the close.
 void atomic_write_bytes(const std::filesystem::path& path, const std::string& bytes);
 

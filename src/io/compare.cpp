@@ -1,10 +1,10 @@
 // Image comparison metrics and the error heat map (nimbus/compare.h).
 #include "nimbus/compare.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
-
-#include <fmt/format.h>
 
 #include "nimbus/error.h"
 
@@ -42,7 +42,8 @@ Binned bin_luminance(const Image& a, const Image& b, int k) {
 
 void check(const Image& a, const Image& b, const CompareOptions& o) {
   if (a.width != b.width || a.height != b.height)
-    throw Error(fmt::format("images differ in size: {}x{} against {}x{}", a.width, a.height, b.width, b.height));
+    throw Error(
+        fmt::format("images differ in size: {}x{} against {}x{}", a.width, a.height, b.width, b.height));
   if (o.bin < 1) throw Error("bin size must be >= 1");
   if (!(o.min_reference >= 0.0)) throw Error("min_reference must be >= 0");
 }

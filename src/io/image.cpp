@@ -1,17 +1,16 @@
 // Image files (nimbus/image.h): EXR read and write, sRGB PNG output, both written atomically.
 #include "nimbus/image.h"
 
-#include <png.h>
-
 #include <OpenEXR/ImfChannelList.h>
 #include <OpenEXR/ImfFrameBuffer.h>
 #include <OpenEXR/ImfHeader.h>
 #include <OpenEXR/ImfInputFile.h>
 #include <OpenEXR/ImfOutputFile.h>
 #include <OpenEXR/ImfStringAttribute.h>
-#include <cmath>
-
 #include <fmt/format.h>
+#include <png.h>
+
+#include <cmath>
 
 #include "io/atomic_file.h"
 #include "nimbus/error.h"

@@ -1,17 +1,17 @@
 // Scene JSON: parsing and validation (docs/scene-format.md is the user-facing description).
+#include <fmt/format.h>
+
 #include <cmath>
 #include <fstream>
 #include <sstream>
-
-#include <fmt/format.h>
 
 #include "core/json_reader.h"
 #include "integrators/registry.h"
 #include "io/scene_volumes.h"
 #include "media/media.h"
 #include "media/phase.h"
-#include "nimbus/render.h"
 #include "nimbus/error.h"
+#include "nimbus/render.h"
 #include "nimbus/scene.h"
 
 namespace nimbus {
@@ -175,7 +175,8 @@ Scene parse_scene(const nlohmann::json& doc, const std::string& name, const std:
     root.fail("media", fmt::format("at most {} media (got {})", kMaxMedia, media.size()));
   for (JsonObject& m : media) scene.media.push_back(parse_medium(m, base_dir));
   for (JsonObject& l : root.array_of_objects("lights", true)) scene.lights.push_back(parse_light(l));
-  if (root.has("integrator")) scene.integrator = parse_integrator(doc["integrator"], root.object("integrator"));
+  if (root.has("integrator"))
+    scene.integrator = parse_integrator(doc["integrator"], root.object("integrator"));
   root.finish();
   scene.source = doc;
   return scene;

@@ -1,9 +1,8 @@
 // The volumes of a scene (scene_volumes.h): .vdb/.nvdb shapes loaded, procedural clouds voxelised.
 #include "io/scene_volumes.h"
 
-#include <nanovdb/util/GridBuilder.h>
-
 #include <fmt/format.h>
+#include <nanovdb/util/GridBuilder.h>
 
 #include "io/vdb.h"
 #include "media/cloud.h"
@@ -13,8 +12,8 @@ namespace nimbus {
 
 void load_vdb_shape(VdbShape& v, const std::filesystem::path& base_dir, const std::string& where,
                     const std::string& json_path) {
-  const std::filesystem::path file = std::filesystem::path(v.file).is_absolute() ? std::filesystem::path(v.file)
-                                                                                   : base_dir / v.file;
+  const std::filesystem::path file =
+      std::filesystem::path(v.file).is_absolute() ? std::filesystem::path(v.file) : base_dir / v.file;
   try {
     v.data = std::make_shared<const DensityGrid>(load_density_grid(file, v.grid));
   } catch (const Error& e) {
@@ -50,7 +49,8 @@ Scene builtin_demo_scene() {
         {"width", 320},
         {"height", 240}}},
       {"media",
-       {{{"shape", {{"type", "cloud"}, {"center", {0, 0, 0}}, {"radius", 1.2}, {"seed", 7}, {"resolution", 128}}},
+       {{{"shape",
+          {{"type", "cloud"}, {"center", {0, 0, 0}}, {"radius", 1.2}, {"seed", 7}, {"resolution", 128}}},
          {"sigma_s", 12.0},
          {"sigma_a", 0.02},
          {"phase", {{"type", "hg"}, {"g", 0.85}}}}}},
@@ -63,6 +63,5 @@ Scene builtin_demo_scene() {
       {"integrator", {{"type", "pathtrace"}, {"spp", 256}, {"seed", 1}}}};
   return parse_scene(doc, "(built-in demo)", ".");
 }
-
 
 }  // namespace nimbus

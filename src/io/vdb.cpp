@@ -107,7 +107,8 @@ struct NvdbEntry {
 // nanovdb::toStr indexes a table with the type: a corrupt file's value must be checked first
 // (found by fuzz/vdb_fuzz.cpp; tests/io/fuzz_regression_test.cpp).
 const char* type_name(nanovdb::GridType t) {
-  return static_cast<uint32_t>(t) < static_cast<uint32_t>(nanovdb::GridType::End) ? nanovdb::toStr(t) : "invalid";
+  return static_cast<uint32_t>(t) < static_cast<uint32_t>(nanovdb::GridType::End) ? nanovdb::toStr(t)
+                                                                                  : "invalid";
 }
 
 std::string version_string(const nanovdb::Version& v) {
@@ -185,7 +186,8 @@ Chunks plan_chunks(const fs::path& file, FileReader& in, const NvdbEntry& e) {
     p += 8;
     if (csize > end - p)
       corrupt_grid(file, e, fmt::format("compressed chunk of {} bytes overruns the grid's data", csize));
-    const uint64_t chunk = e.codec == Codec::BLOSC ? std::min<uint64_t>(residual, uint64_t(1) << 30) : residual;
+    const uint64_t chunk =
+        e.codec == Codec::BLOSC ? std::min<uint64_t>(residual, uint64_t(1) << 30) : residual;
     if (e.codec == Codec::ZIP) {
       if (grid_size > 1040 * csize + 1024)  // zlib cannot compress better than ~1032:1
         corrupt_grid(file, e, fmt::format("{} bytes cannot inflate to {} bytes", csize, grid_size));
@@ -195,7 +197,8 @@ Chunks plan_chunks(const fs::path& file, FileReader& in, const NvdbEntry& e) {
       in.read(p, bh, sizeof(bh), "a BLOSC header");
       size_t nbytes = 0;
       if (blosc_cbuffer_validate(bh, csize, &nbytes) != 0 || nbytes != chunk)
-        corrupt_grid(file, e, fmt::format("BLOSC header does not match the grid size ({} bytes expected)", chunk));
+        corrupt_grid(file, e,
+                     fmt::format("BLOSC header does not match the grid size ({} bytes expected)", chunk));
     }
     chunks.emplace_back(p, csize);
     p += csize;
@@ -205,7 +208,8 @@ Chunks plan_chunks(const fs::path& file, FileReader& in, const NvdbEntry& e) {
 }
 
 // Fills dst (grid_size bytes) from the file: a plain copy, or the planned chunks decompressed.
-void read_grid_bytes(const fs::path& file, FileReader& in, const NvdbEntry& e, const Chunks& chunks, uint8_t* dst) {
+void read_grid_bytes(const fs::path& file, FileReader& in, const NvdbEntry& e, const Chunks& chunks,
+                     uint8_t* dst) {
   using nanovdb::io::Codec;
   const uint64_t grid_size = e.meta.gridSize;
   if (e.codec == Codec::NONE) {
@@ -262,7 +266,7 @@ struct GridBytes {
   const fs::path& file;
   const uint8_t* base;
   uint64_t size;
-  uint64_t nodes_begin = 0;  // first byte after the root table
+  uint64_t nodes_begin = 0;       // first byte after the root table
   uint32_t nodes[3] = {0, 0, 0};  // leaf, lower, upper nodes found
 
   [[noreturn]] void corrupt(const std::string& what) const { fail(file, "corrupt grid data: " + what); }
@@ -274,7 +278,8 @@ struct GridBytes {
   uint64_t child_off(uint64_t parent, int64_t rel, uint64_t node_size) const {
     const uint64_t c = parent + static_cast<uint64_t>(rel);  // wraps for bad negative offsets
     if (c < nodes_begin || c > size || node_size > size - c || c % 32 != 0)
-      corrupt(fmt::format("node pointer outside the buffer (offset {} of {})", static_cast<int64_t>(c), size));
+      corrupt(
+          fmt::format("node pointer outside the buffer (offset {} of {})", static_cast<int64_t>(c), size));
     return c;
   }
 };
@@ -285,7 +290,8 @@ void check_grid_header(const GridBytes& b) {
     b.corrupt("buffer too small");
   const auto* gd = b.at<nanovdb::GridData>(0);
   if (gd->mMagic != NANOVDB_MAGIC_NUMBER) b.corrupt("bad magic number");
-  if (gd->mGridSize != b.size) b.corrupt(fmt::format("grid size {} != buffer size {}", gd->mGridSize, b.size));
+  if (gd->mGridSize != b.size)
+    b.corrupt(fmt::format("grid size {} != buffer size {}", gd->mGridSize, b.size));
   if (gd->mVersion.getMajor() != NANOVDB_MAJOR_VERSION_NUMBER)
     b.corrupt(fmt::format("grid version {}", version_string(gd->mVersion)));
   if (gd->mGridType != nanovdb::GridType::Float)
@@ -408,11 +414,11 @@ NanoHandle open_nvdb_grid(const fs::path& file, const std::string& grid_name) {
   if (chosen == nullptr || chosen->meta.gridType != nanovdb::GridType::Float) {
     std::string list;
     for (const auto& e : entries)
-      list += fmt::format("{}\"{}\" ({})", list.empty() ? "" : ", ", e.meta.gridName,
-                          type_name(e.meta.gridType));
+      list +=
+          fmt::format("{}\"{}\" ({})", list.empty() ? "" : ", ", e.meta.gridName, type_name(e.meta.gridType));
     if (chosen != nullptr)
-      fail(file, fmt::format("grid \"{}\" is of type {}, not float", grid_name,
-                             type_name(chosen->meta.gridType)));
+      fail(file,
+           fmt::format("grid \"{}\" is of type {}, not float", grid_name, type_name(chosen->meta.gridType)));
     if (grid_name.empty()) fail(file, "no float grid in the file; it holds " + list);
     fail(file, fmt::format("no grid named \"{}\"; the file holds {}", grid_name, list));
   }
@@ -432,7 +438,8 @@ DensityGrid load_density_grid(const fs::path& file, const std::string& grid_name
   // Only after the structural check: the checksum reads the root table and every node through the
   // grid's own sizes and offsets (a corrupt root table size read past the buffer; see
   // tests/io/fuzz_regression_test.cpp).
-  if (kind == FileKind::NanoVDB && !nanovdb::validateChecksum(*checked_float_grid(handle), nanovdb::ChecksumMode::Full))
+  if (kind == FileKind::NanoVDB &&
+      !nanovdb::validateChecksum(*checked_float_grid(handle), nanovdb::ChecksumMode::Full))
     fail(file, "corrupt grid data: checksum mismatch");
   const double read_seconds = std::chrono::duration<double>(t1 - t0).count();
   const double check_seconds = std::chrono::duration<double>(Clock::now() - t1).count();
@@ -483,7 +490,8 @@ void recount_float_grid(const fs::path& file, FileReader& in, const NvdbEntry& e
   if (gi.empty) return;
   for (int a = 0; a < 3; ++a) gi.index_min[a] = w.bbox.min()[a], gi.index_max[a] = w.bbox.max()[a];
   for (int c = 0; c < 8; ++c) {
-    const nanovdb::Vec3d p(c & 1 ? gi.index_max[0] : gi.index_min[0], c & 2 ? gi.index_max[1] : gi.index_min[1],
+    const nanovdb::Vec3d p(c & 1 ? gi.index_max[0] : gi.index_min[0],
+                           c & 2 ? gi.index_max[1] : gi.index_min[1],
                            c & 4 ? gi.index_max[2] : gi.index_min[2]);
     const auto q = grid->indexToWorld(p);
     gi.world_bounds.extend(Vec3(q[0], q[1], q[2]));

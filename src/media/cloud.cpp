@@ -14,9 +14,18 @@ double fade(double t) { return t * t * t * (t * (t * 6.0 - 15.0) + 10.0); }
 double lattice_dot(int ix, int iy, int iz, uint32_t seed, double dx, double dy, double dz) {
   const uint64_t h = mix64((uint64_t(uint32_t(ix)) * 73856093u) ^ (uint64_t(uint32_t(iy)) * 19349663u << 20) ^
                            (uint64_t(uint32_t(iz)) * 83492791u << 40) ^ (uint64_t(seed) << 32));
-  static constexpr std::array<std::array<int, 3>, 12> g = {{{1, 1, 0}, {-1, 1, 0}, {1, -1, 0}, {-1, -1, 0},
-                                                            {1, 0, 1}, {-1, 0, 1}, {1, 0, -1}, {-1, 0, -1},
-                                                            {0, 1, 1}, {0, -1, 1}, {0, 1, -1}, {0, -1, -1}}};
+  static constexpr std::array<std::array<int, 3>, 12> g = {{{1, 1, 0},
+                                                            {-1, 1, 0},
+                                                            {1, -1, 0},
+                                                            {-1, -1, 0},
+                                                            {1, 0, 1},
+                                                            {-1, 0, 1},
+                                                            {1, 0, -1},
+                                                            {-1, 0, -1},
+                                                            {0, 1, 1},
+                                                            {0, -1, 1},
+                                                            {0, 1, -1},
+                                                            {0, -1, -1}}};
   const auto& v = g[h % 12];
   return v[0] * dx + v[1] * dy + v[2] * dz;
 }

@@ -118,14 +118,16 @@ struct BrickRange {
 };
 
 // The voxels [b0, b1] of a leaf: their max, and the owned ones counted.
-float scan_leaf_block(const LeafT& leaf, const int b0[3], const int b1[3], const BrickRange& br, ValueCounts& out) {
+float scan_leaf_block(const LeafT& leaf, const int b0[3], const int b1[3], const BrickRange& br,
+                      ValueCounts& out) {
   float m = 0.0f;
   for (int i = b0[0]; i <= b1[0]; ++i)
     for (int j = b0[1]; j <= b1[1]; ++j)
       for (int k = b0[2]; k <= b1[2]; ++k) {
         const float v = leaf.getValue(Coord(i, j, k));
         m = std::max(m, v);
-        if (i < br.s[0] || j < br.s[1] || k < br.s[2] || i > br.own_hi[0] || j > br.own_hi[1] || k > br.own_hi[2])
+        if (i < br.s[0] || j < br.s[1] || k < br.s[2] || i > br.own_hi[0] || j > br.own_hi[1] ||
+            k > br.own_hi[2])
           continue;
         if (!std::isfinite(v)) {
           out.note_bad(Coord(i, j, k), 1);
@@ -224,8 +226,9 @@ void check_finite(const std::string& source, const nanovdb::FloatGrid& grid, con
   if (counts.bad == 0) return;
   const Coord& c = counts.first_bad;
   const auto wp = grid.indexToWorld(nanovdb::Vec3d(c[0], c[1], c[2]));
-  fail(source, fmt::format("{} NaN/inf density values (first at index [{}, {}, {}], world ({:.6g}, {:.6g}, {:.6g}))",
-                           counts.bad, c[0], c[1], c[2], wp[0], wp[1], wp[2]));
+  fail(source,
+       fmt::format("{} NaN/inf density values (first at index [{}, {}, {}], world ({:.6g}, {:.6g}, {:.6g}))",
+                   counts.bad, c[0], c[1], c[2], wp[0], wp[1], wp[2]));
 }
 
 // The grid in a handle, which must hold a float grid.
@@ -259,8 +262,8 @@ GridSummary summarize_float_grid(const nanovdb::FloatGrid& grid) {
 
 // ---- DensityGrid ----------------------------------------------------------------------------------
 
-DensityGrid DensityGrid::from_nanovdb(nanovdb::GridHandle<nanovdb::HostBuffer> handle, const std::string& source,
-                                      double read_seconds, double check_seconds) {
+DensityGrid DensityGrid::from_nanovdb(nanovdb::GridHandle<nanovdb::HostBuffer> handle,
+                                      const std::string& source, double read_seconds, double check_seconds) {
   const auto t1 = std::chrono::steady_clock::now();
   auto data = std::make_shared<Data>();
   data->handle = std::move(handle);

@@ -109,7 +109,6 @@ class DensityGrid {
   struct Data;  // owns the NanoVDB buffer, the brick array and the stats (shared by copies)
 
  private:
-
   template <typename Acc>
   double trilinear(Acc& acc, const Vec3& p) const;
 

@@ -22,7 +22,8 @@ const DensityGrid* grid_of(const Shape& s) {
 template <typename F>
 Bounds transform_box(const Vec3& lo, const Vec3& hi, F&& f) {
   Bounds b;
-  for (int k = 0; k < 8; ++k) b.extend(f(Vec3(k & 1 ? hi.x : lo.x, k & 2 ? hi.y : lo.y, k & 4 ? hi.z : lo.z)));
+  for (int k = 0; k < 8; ++k)
+    b.extend(f(Vec3(k & 1 ? hi.x : lo.x, k & 2 ? hi.y : lo.y, k & 4 ? hi.z : lo.z)));
   return b;
 }
 
@@ -55,9 +56,11 @@ SceneMedia::SceneMedia(const std::vector<Medium>& media) : media_(media) {
 double SceneMedia::density(int i, const Vec3& p) const {
   const Shape& s = media_[i].shape;
   if (!medium_bounds_[i].contains(p)) return 0.0;
-  if (const auto* sp = std::get_if<SphereShape>(&s)) return (p - sp->center).length2() <= sp->radius * sp->radius;
+  if (const auto* sp = std::get_if<SphereShape>(&s))
+    return (p - sp->center).length2() <= sp->radius * sp->radius;
   if (std::holds_alternative<BoxShape>(s)) return 1.0;
-  if (const auto* v = std::get_if<VdbShape>(&s)) return v->data->density_index(v->data->world_to_index(vdb_grid_world(*v, p)));
+  if (const auto* v = std::get_if<VdbShape>(&s))
+    return v->data->density_index(v->data->world_to_index(vdb_grid_world(*v, p)));
   const DensityGrid* g = grid_of(s);
   return g->density_index(g->world_to_index(p));
 }
@@ -76,9 +79,8 @@ double SceneMedia::max_density(int i, const Bounds& box) const {
   if (std::holds_alternative<BoxShape>(s)) return 1.0;
   const DensityGrid* g = grid_of(s);
   const auto* v = std::get_if<VdbShape>(&s);
-  const Bounds ib = transform_box(box.lo, box.hi, [&](const Vec3& p) {
-    return g->world_to_index(v ? vdb_grid_world(*v, p) : p);
-  });
+  const Bounds ib = transform_box(
+      box.lo, box.hi, [&](const Vec3& p) { return g->world_to_index(v ? vdb_grid_world(*v, p) : p); });
   return g->max_density_index(ib.lo, ib.hi);
 }
 

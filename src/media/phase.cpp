@@ -1,10 +1,10 @@
 #include "media/phase.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <bit>
 #include <cmath>
-
-#include <fmt/format.h>
 
 #include "core/rng.h"
 #include "nimbus/error.h"
@@ -156,9 +156,7 @@ Vec3 phase_sample(const Phase& phase, const Vec3& wi, double u1, double u2) {
       }
       return 1.0;
     }
-    double operator()(const TabulatedPhase& p) const {
-      return std::cos(tabulated_sample_theta(p, u1));
-    }
+    double operator()(const TabulatedPhase& p) const { return std::cos(tabulated_sample_theta(p, u1)); }
   } visitor{u1, u2};
   const double cos_theta = std::visit(visitor, phase);
   // Azimuth: the Gaussian sampler consumed u2, so it takes phi from a stream hashed from (u1, u2).

@@ -19,7 +19,7 @@ double hg_eval(double cos_theta, double g);
 double hg_sample_cos(double u, double g);
 // <theta^2> per component of the small-angle expansion Z(p) ~ 1 - theta2 p^2 / 2 is infinite for HG
 // (its forward peak is Cauchy-like, ../shared/notes/mfs-math.md); these are the usual stand-ins.
-double hg_theta2_one_minus_g(double g);       // (1 - g)
+double hg_theta2_one_minus_g(double g);         // (1 - g)
 double hg_theta2_one_minus_g2_over3(double g);  // (1 - g^2) / 3
 
 // The phase function structs (IsotropicPhase ... TabulatedPhase, Phase) are in nimbus/phase.h.

@@ -4,15 +4,15 @@
 // count; progress and cancellation go through callbacks.
 #include "nimbus/render.h"
 
-#include <chrono>
-#include <cmath>
-#include <memory>
-#include <optional>
-
 #include <fmt/format.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
+
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <optional>
 
 #include "integrators/registry.h"
 #include "nimbus/error.h"
@@ -36,7 +36,8 @@ IntegratorSettings resolve_settings(const Scene& scene, const RenderOptions& opt
     settings.type = *options.integrator;
     settings.options = nlohmann::json::object();
   }
-  if (settings.spp < 1 || settings.spp > kMaxSpp) throw Error(fmt::format("spp must be between 1 and {}", kMaxSpp));
+  if (settings.spp < 1 || settings.spp > kMaxSpp)
+    throw Error(fmt::format("spp must be between 1 and {}", kMaxSpp));
   if (options.threads < 0) throw Error("threads must be >= 0");
   if (options.tile_size < 1) throw Error("tile size must be >= 1");
   return settings;
@@ -57,8 +58,8 @@ nlohmann::json resolved_block(const IntegratorSettings& settings, const Integrat
 // by a random offset per pixel (a Cranley-Patterson rotation, so each sample is still uniform over the
 // pixel and the estimate unbiased); its samples are spread evenly for every spp, which halves edge noise
 // at a few spp. Returns the number of non-finite samples (dropped).
-int64_t render_pixel(const Integrator& integrator, const PinholeCamera& camera, const IntegratorSettings& settings,
-                     int x, int y, Film& film) {
+int64_t render_pixel(const Integrator& integrator, const PinholeCamera& camera,
+                     const IntegratorSettings& settings, int x, int y, Film& film) {
   Rng shift = Rng::for_sample(settings.seed, uint32_t(x), uint32_t(y), ~uint64_t(0));
   const double ux = shift.uniform(), uy = shift.uniform();
   int64_t bad = 0;

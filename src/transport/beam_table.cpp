@@ -3,10 +3,10 @@
 // of given optical depth.
 #include "transport/beam_table.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
-
-#include <fmt/format.h>
 
 #include "core/math.h"
 #include "nimbus/error.h"
@@ -47,28 +47,33 @@ namespace {
 // The settings with defaults filled in, after checking them and the model names.
 BeamSettings checked_beam_settings(const BeamSettings& in, const std::vector<std::string>& models) {
   BeamSettings s = in;
-  if (!(s.albedo > 0.0 && s.albedo <= 1.0)) throw Error(fmt::format("albedo must lie in (0, 1] (got {})", s.albedo));
+  if (!(s.albedo > 0.0 && s.albedo <= 1.0))
+    throw Error(fmt::format("albedo must lie in (0, 1] (got {})", s.albedo));
   if (s.depths.empty()) throw Error("at least one depth is needed");
   for (size_t i = 0; i < s.depths.size(); ++i) {
-    if (!(s.depths[i] > 0.0) || !std::isfinite(s.depths[i])) throw Error(fmt::format("depth {} must be > 0", s.depths[i]));
+    if (!(s.depths[i] > 0.0) || !std::isfinite(s.depths[i]))
+      throw Error(fmt::format("depth {} must be > 0", s.depths[i]));
     if (i > 0 && !(s.depths[i] > s.depths[i - 1])) throw Error("depths must increase");
-    if (!(s.depths[i] < s.thickness)) throw Error(fmt::format("depth {} must lie inside the slab (thickness {})", s.depths[i], s.thickness));
+    if (!(s.depths[i] < s.thickness))
+      throw Error(fmt::format("depth {} must lie inside the slab (thickness {})", s.depths[i], s.thickness));
   }
   if (s.theta_edges.empty()) s.theta_edges = default_theta_edges();
   if (s.r_edges.empty()) s.r_edges = default_r_edges();
   for (const std::vector<double>* e : {&s.theta_edges, &s.r_edges})
     if (e->size() < 2) throw Error("bin edges need at least two values");
   for (const auto& m : models)
-    if (m != "mc_fwd" && std::find(beam_model_names().begin(), beam_model_names().end(), m) == beam_model_names().end())
-      throw Error(fmt::format("unknown model '{}' (known: mc, dolin, tes87, mfs, gsa; diagnostic: mc_fwd)", m));
+    if (m != "mc_fwd" &&
+        std::find(beam_model_names().begin(), beam_model_names().end(), m) == beam_model_names().end())
+      throw Error(
+          fmt::format("unknown model '{}' (known: mc, dolin, tes87, mfs, gsa; diagnostic: mc_fwd)", m));
   return s;
 }
 
 // Rows of a deterministic model at depth z from its cumulative angular and radial power; `entry` is
 // the fraction that enters the medium, `a` the absorption per scattering length.
 template <typename WithinAngle, typename WithinRadius>
-void add_model_rows(std::vector<BeamRow>& rows, const BeamSettings& s, const std::string& name, double z, double entry,
-                    double a, WithinAngle&& within_angle, WithinRadius&& within_radius) {
+void add_model_rows(std::vector<BeamRow>& rows, const BeamSettings& s, const std::string& name, double z,
+                    double entry, double a, WithinAngle&& within_angle, WithinRadius&& within_radius) {
   const auto& te = s.theta_edges;
   const auto& re = s.r_edges;
   auto solid_angle = [&](size_t i) { return 2.0 * kPi * (std::cos(te[i]) - std::cos(te[i + 1])); };
@@ -138,16 +143,20 @@ std::vector<BeamRow> beam_table(const BeamSettings& in, const std::vector<std::s
       const ForwardPropagator prop(s.phase);
       for (double z : s.depths) {
         const ForwardProfile p = prop.profile(z, a * z);
-        add_model_rows(rows, s, m, z, entry, a, [&](double t) { return p.angular_within(t); },
-                       [&](double r) { return p.radial_within(r); });
+        add_model_rows(
+            rows, s, m, z, entry, a, [&](double t) { return p.angular_within(t); },
+            [&](double r) { return p.radial_within(r); });
       }
     } else {
-      const GaussianModel gm = m == "dolin" ? GaussianModel::Dolin : m == "tes87" ? GaussianModel::Tes87 : GaussianModel::Mfs;
+      const GaussianModel gm = m == "dolin"   ? GaussianModel::Dolin
+                               : m == "tes87" ? GaussianModel::Tes87
+                                              : GaussianModel::Mfs;
       const double theta2 = phase_theta2(s.phase);
       for (double z : s.depths) {
         const GaussianBeam g = gaussian_beam(gm, z, z, a * z, theta2);
-        add_model_rows(rows, s, m, z, entry, a, [&](double t) { return g.angular_within(t); },
-                       [&](double r) { return g.radial_within(r); });
+        add_model_rows(
+            rows, s, m, z, entry, a, [&](double t) { return g.angular_within(t); },
+            [&](double r) { return g.radial_within(r); });
       }
     }
   }

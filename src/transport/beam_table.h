@@ -14,10 +14,10 @@ namespace nimbus {
 
 struct BeamSettings {
   Phase phase = HgPhase{0.9};
-  double albedo = 0.99;             // b / c, in (0, 1]
-  std::vector<double> depths;       // optical depths b z of the planes, increasing, > 0
+  double albedo = 0.99;        // b / c, in (0, 1]
+  std::vector<double> depths;  // optical depths b z of the planes, increasing, > 0
   double thickness = std::numeric_limits<double>::infinity();  // slab [0, D] in mfp, or infinite
-  double n = 1.0;                   // slab refractive index against 1 outside
+  double n = 1.0;                                              // slab refractive index against 1 outside
   uint64_t photons = 1000000;
   uint64_t seed = 1;
   int batches = 20;
@@ -26,7 +26,7 @@ struct BeamSettings {
 };
 
 struct BeamRow {
-  std::string model;     // mc, dolin, tes87, mfs, gsa
+  std::string model;  // mc, dolin, tes87, mfs, gsa
   double depth = 0.0;
   std::string quantity;  // angular (per sr), radial (per area), unscattered
   double lo = 0.0, hi = 0.0, value = 0.0, stderr_ = 0.0;

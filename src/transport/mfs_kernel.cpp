@@ -1,9 +1,9 @@
 // The MFS Green's function and the older small-angle beam forms (mfs_kernel.h).
 #include "transport/mfs_kernel.h"
 
-#include <cmath>
-
 #include <fmt/format.h>
+
+#include <cmath>
 
 #include "core/math.h"
 #include "nimbus/error.h"
@@ -30,7 +30,8 @@ double tanh_over_x(double x) { return x < 1e-4 ? 1.0 - x * x / 3.0 : std::tanh(x
 double sech(double x) { return 2.0 * std::exp(-x) / (1.0 + std::exp(-2.0 * x)); }
 
 void check_finite_nonneg(double v, const char* name) {
-  if (!std::isfinite(v) || v < 0.0) throw Error(fmt::format("mfs kernel: {} must be finite and >= 0 (got {})", name, v));
+  if (!std::isfinite(v) || v < 0.0)
+    throw Error(fmt::format("mfs kernel: {} must be finite and >= 0 (got {})", name, v));
 }
 
 }  // namespace
@@ -46,16 +47,19 @@ double mfs_h_over_x3(double x) {
   // 2 tanh(x/2) = x - x^3/12 + x^5/120 - 17 x^7/20160 + 62 x^9/725760 - 2764 x^11/(155925 2^11) + ...
   if (std::abs(x) < 0.1) {
     const double x4 = x2 * x2;
-    return 1.0 / 12.0 - x2 / 120.0 + 17.0 * x4 / 20160.0 - 62.0 * x4 * x2 / 725760.0 + 2764.0 * x4 * x4 / (155925.0 * 2048.0);
+    return 1.0 / 12.0 - x2 / 120.0 + 17.0 * x4 / 20160.0 - 62.0 * x4 * x2 / 725760.0 +
+           2764.0 * x4 * x4 / (155925.0 * 2048.0);
   }
   return (x - 2.0 * std::tanh(0.5 * x)) / (x2 * x);
 }
 
 MfsScales mfs_scales(GaussianModel model, double z, double tau_s, double tau_a, double theta2) {
-  if (!(z > 0.0) || !std::isfinite(z)) throw Error(fmt::format("mfs kernel: path length z must be > 0 (got {})", z));
+  if (!(z > 0.0) || !std::isfinite(z))
+    throw Error(fmt::format("mfs kernel: path length z must be > 0 (got {})", z));
   check_finite_nonneg(tau_s, "tau_s");
   check_finite_nonneg(tau_a, "tau_a");
-  if (!(theta2 > 0.0) || !std::isfinite(theta2)) throw Error(fmt::format("mfs kernel: theta2 must be > 0 (got {})", theta2));
+  if (!(theta2 > 0.0) || !std::isfinite(theta2))
+    throw Error(fmt::format("mfs kernel: theta2 must be > 0 (got {})", theta2));
   MfsScales s;
   s.z = z;
   const double one_minus_ebz = -std::expm1(-tau_s);  // 1 - exp(-b z)
@@ -91,8 +95,10 @@ double mfs_green(const MfsScales& s, const Vec2& gamma, const Vec2& gamma_prime)
   const double t2 = x < 1e-4 ? 0.5 : std::tanh(0.5 * x) / x;  // tanh(x/2) / x
   const double q = t2 * t2 / hx3;                             // x tanh^2(x/2) / h(x) (-> 3 at x = 0)
   const Vec2 sum = gamma + gamma_prime;
-  const double M = ((gamma.length2() + gamma_prime.length2()) * x_coth(x) - 2.0 * gamma.dot(gamma_prime) * x_csch(x)) / (2.0 * tz) +
-                   sum.length2() * q / (2.0 * tz);
+  const double M =
+      ((gamma.length2() + gamma_prime.length2()) * x_coth(x) - 2.0 * gamma.dot(gamma_prime) * x_csch(x)) /
+          (2.0 * tz) +
+      sum.length2() * q / (2.0 * tz);
   const double pref = s.W / (4.0 * kPi * kPi * tz * tz * s.z * s.z) * x_csch(x) / hx3;
   return pref * std::exp(-M);
 }
@@ -108,7 +114,8 @@ double mfs_fixed_axis(const MfsScales& s, const Vec2& r, const Vec2& v, const Ve
   if (!(s.T > 0.0)) return 0.0;
   const double x = s.x, tz = s.T * s.z;
   const double hx3 = mfs_h_over_x3(x);
-  const double l_tanh = x < 1e-4 ? 0.5 * s.z * (1.0 - x * x / 12.0) : s.z * std::tanh(0.5 * x) / x;  // L tanh(x/2)
+  const double l_tanh =
+      x < 1e-4 ? 0.5 * s.z * (1.0 - x * x / 12.0) : s.z * std::tanh(0.5 * x) / x;  // L tanh(x/2)
   const Vec2 d = r - (v0 + v) * l_tanh;
   const double S = ((v0.length2() + v.length2()) * x_coth(x) - 2.0 * v0.dot(v) * x_csch(x)) / (2.0 * tz) +
                    d.length2() / (2.0 * tz * s.z * s.z * hx3);
@@ -121,10 +128,11 @@ GaussianBeam gaussian_beam(GaussianModel model, double z, double tau_s, double t
   const double x = s.x, tz = s.T * s.z;
   GaussianBeam g;
   g.total = s.W * sech(x);
-  g.var_angle = tz * tanh_over_x(x);  // T L tanh x
+  g.var_angle = tz * tanh_over_x(x);                                                 // T L tanh x
   const double t2 = x < 1e-4 ? 0.5 * (1.0 - x * x / 12.0) : std::tanh(0.5 * x) / x;  // tanh(x/2) / x
-  g.var_radius = tz * s.z * s.z * (mfs_h_over_x3(x) + t2 * t2 * tanh_over_x(x));  // T L^3 [h + tanh^2(x/2) tanh x]
-  g.cov = s.z * t2 * g.var_angle;  // L tanh(x/2) T L tanh x
+  g.var_radius =
+      tz * s.z * s.z * (mfs_h_over_x3(x) + t2 * t2 * tanh_over_x(x));  // T L^3 [h + tanh^2(x/2) tanh x]
+  g.cov = s.z * t2 * g.var_angle;                                      // L tanh(x/2) T L tanh x
   return g;
 }
 

@@ -1,13 +1,13 @@
 // Phase functions from short command-line specs (phase_spec.h).
 #include "transport/phase_spec.h"
 
+#include <fmt/format.h>
+
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
 #include <vector>
-
-#include <fmt/format.h>
 
 #include "nimbus/error.h"
 
@@ -17,7 +17,8 @@ namespace {
 
 std::vector<double> parse_numbers(const std::string& spec, const std::string& list, size_t count) {
   const std::vector<double> v = parse_number_list(fmt::format("phase '{}'", spec), list);
-  if (v.size() != count) throw Error(fmt::format("phase '{}': expected {} number(s), got {}", spec, count, v.size()));
+  if (v.size() != count)
+    throw Error(fmt::format("phase '{}': expected {} number(s), got {}", spec, count, v.size()));
   return v;
 }
 
@@ -91,7 +92,8 @@ Phase parse_phase_spec(const std::string& spec) {
     const auto v = parse_numbers(spec, args, 3);
     check_g(spec, v[0]);
     check_g(spec, v[1]);
-    if (!(v[2] >= 0.0 && v[2] <= 1.0)) throw Error(fmt::format("phase '{}': weight W must lie in [0, 1]", spec));
+    if (!(v[2] >= 0.0 && v[2] <= 1.0))
+      throw Error(fmt::format("phase '{}': weight W must lie in [0, 1]", spec));
     return DoubleHgPhase{v[0], v[1], v[2]};
   }
   if (kind == "gauss") {
@@ -100,12 +102,15 @@ Phase parse_phase_spec(const std::string& spec) {
     return make_gauss_phase(t);
   }
   if (kind == "mie") {
-    if (args.empty() || args.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-.") != std::string::npos ||
+    if (args.empty() ||
+        args.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-.") !=
+            std::string::npos ||
         args[0] == '.')
       throw Error(fmt::format("phase '{}': mie needs a table name of letters, digits, '_', '-', '.'", spec));
     return load_phase_table(args, phase_table_dir() + "/" + args + ".csv");
   }
-  throw Error(fmt::format("phase '{}': unknown type (use iso, hg:G, dhg:G1,G2,W, gauss:THETA2 or mie:NAME)", spec));
+  throw Error(
+      fmt::format("phase '{}': unknown type (use iso, hg:G, dhg:G1,G2,W, gauss:THETA2 or mie:NAME)", spec));
 }
 
 }  // namespace nimbus

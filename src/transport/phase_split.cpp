@@ -2,10 +2,10 @@
 // a wide remainder, with tables of both lobes after peak scattering (PhaseSplit, phase_split.h).
 #include "transport/phase_split.h"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
-
-#include <tbb/parallel_for.h>
 
 #include "core/math.h"
 #include "nimbus/error.h"
@@ -58,14 +58,15 @@ std::vector<double> wide_part_moments(const Phase& phase, double theta_c, double
     }
     if (th == theta_c && !theta.empty() && theta.back() == th) continue;
     theta.push_back(th);
-    value.push_back(th < theta_c ? std::min(phase_eval(phase, std::cos(th)), level) : phase_eval(phase, std::cos(th)));
+    value.push_back(th < theta_c ? std::min(phase_eval(phase, std::cos(th)), level)
+                                 : phase_eval(phase, std::cos(th)));
   }
   return phase_legendre_moments(make_tabulated_phase("mfs-wide", theta, value), 1e-8, kMomentCap);
 }
 
 // The peak's moments by difference (or its Gaussian with the same <theta^2>); a delta without a peak.
-std::vector<double> peak_part_moments(const std::vector<double>& chi_full, const std::vector<double>& chi_wide,
-                                      double f, bool gaussian) {
+std::vector<double> peak_part_moments(const std::vector<double>& chi_full,
+                                      const std::vector<double>& chi_wide, double f, bool gaussian) {
   const size_t L = chi_full.size();
   std::vector<double> chi_peak(L, 1.0);  // no peak: a delta (tau_p stays 0 anyway)
   if (f > 0.0) {
@@ -108,8 +109,7 @@ void tabulate_lobes(const std::vector<double>& chi_wide, const std::vector<doubl
     const double v = double(k) / (kTauNodes - 1);
     tau[k] = PhaseSplit::kTauMax * v * v;
     e_tau[k] = std::exp(-tau[k]);
-    for (size_t l = 0; l < L; ++l)
-      E[k * L + l] = std::exp(-tau[k] * (1.0 - chi_peak[l])) - e_tau[k];
+    for (size_t l = 0; l < L; ++l) E[k * L + l] = std::exp(-tau[k] * (1.0 - chi_peak[l])) - e_tau[k];
   }
   wide_table.assign(size_t(kTauNodes) * kAngleNodes, 0.0f);
   peak_table.assign(size_t(kTauNodes) * kAngleNodes, 0.0f);
@@ -158,8 +158,9 @@ PhaseSplit::PhaseSplit(const Phase& phase, double peak_fraction, bool gaussian) 
   chi_wide_.resize(L, 0.0);
   chi_peak_ = peak_part_moments(chi_full, chi_wide_, f_, gaussian);
 
-  tabulate_lobes(chi_wide_, chi_peak_, [this](double mu) { return wide(mu); }, [this](double mu) { return peak(mu); },
-                 wide_table_, peak_table_);
+  tabulate_lobes(
+      chi_wide_, chi_peak_, [this](double mu) { return wide(mu); }, [this](double mu) { return peak(mu); },
+      wide_table_, peak_table_);
 }
 
 double PhaseSplit::wide(double cos_theta) const {

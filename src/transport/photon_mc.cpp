@@ -2,12 +2,12 @@
 // the tallies at planes and faces, and batch-mean error estimates (photon_mc.h).
 #include "transport/photon_mc.h"
 
-#include <algorithm>
-#include <cmath>
-
 #include <fmt/format.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
 
 #include "core/rng.h"
 #include "nimbus/error.h"
@@ -114,8 +114,10 @@ class Tracer {
       const double s = sigma_t_ > 0.0 ? -std::log(1.0 - rng.uniform()) / sigma_t_ : inf;
       double s_face = inf;
       if (slab_) {
-        if (d.z > 0.0) s_face = (s_.thickness - p.z) / d.z;
-        else if (d.z < 0.0) s_face = -p.z / d.z;
+        if (d.z > 0.0)
+          s_face = (s_.thickness - p.z) / d.z;
+        else if (d.z < 0.0)
+          s_face = -p.z / d.z;
       }
       const bool hits = s >= s_face;
       const double step = hits ? s_face : s;
@@ -162,15 +164,19 @@ class Tracer {
   // depth roulette too, halving the population per transport length beyond the tallies.
   bool survives_roulette(Rng& rng, const Vec3& p, double& w, int& zone_seen) const {
     if (w < kRouletteThreshold) {
-      if (rng.uniform() < kRouletteSurvival) w /= kRouletteSurvival;
-      else return false;
+      if (rng.uniform() < kRouletteSurvival)
+        w /= kRouletteSurvival;
+      else
+        return false;
     }
     if (!slab_) {
       const double zone = std::max(std::floor((p.z - z_last_) / zone_len_), std::floor(-p.z / zone_len_));
       while (zone > zone_seen) {
         ++zone_seen;
-        if (rng.uniform() < 0.5) w *= 2.0;
-        else return false;
+        if (rng.uniform() < 0.5)
+          w *= 2.0;
+        else
+          return false;
       }
     }
     return true;
@@ -207,7 +213,8 @@ class Tracer {
     }
   }
 
-  void tally_exit(bool bottom, double theta_out, const Vec3& p, double wt, bool scattered, double* acc) const {
+  void tally_exit(bool bottom, double theta_out, const Vec3& p, double wt, bool scattered,
+                  double* acc) const {
     const int ia = bin_of(s_.theta_edges, theta_out);
     const int ir = bin_of(s_.r_edges, std::hypot(p.x, p.y));
     if (bottom) {
@@ -286,8 +293,12 @@ PhotonMcResult run_photon_mc(const PhotonMcSettings& s) {
   const Layout L{s.plane_depths.size(), NA, NR};
   const Batches batches = trace_batches(s, L);
   auto estimate = [&](size_t j, double scale) { return batch_estimate(batches, s.photons, j, scale); };
-  auto solid_angle = [&](size_t i) { return 2.0 * kPi * (std::cos(s.theta_edges[i]) - std::cos(s.theta_edges[i + 1])); };
-  auto area = [&](size_t i) { return kPi * (s.r_edges[i + 1] * s.r_edges[i + 1] - s.r_edges[i] * s.r_edges[i]); };
+  auto solid_angle = [&](size_t i) {
+    return 2.0 * kPi * (std::cos(s.theta_edges[i]) - std::cos(s.theta_edges[i + 1]));
+  };
+  auto area = [&](size_t i) {
+    return kPi * (s.r_edges[i + 1] * s.r_edges[i + 1] - s.r_edges[i] * s.r_edges[i]);
+  };
 
   PhotonMcResult r;
   for (size_t k = 0; k < L.P; ++k) {

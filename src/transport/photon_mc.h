@@ -42,9 +42,9 @@ struct PhotonMcSettings {
   Phase phase = HgPhase{0.9};
   double thickness = std::numeric_limits<double>::infinity();  // slab [0, D]; infinity = infinite medium
   double n = 1.0;                                              // slab refractive index (1 outside)
-  std::vector<double> plane_depths;  // [length], > 0 (and < thickness), increasing
-  std::vector<double> theta_edges;   // [rad], increasing in [0, pi]: plane angular bins and exit bins
-  std::vector<double> r_edges;       // [length], increasing, >= 0: plane radial bins and exit bins
+  std::vector<double> plane_depths;                            // [length], > 0 (and < thickness), increasing
+  std::vector<double> theta_edges;  // [rad], increasing in [0, pi]: plane angular bins and exit bins
+  std::vector<double> r_edges;      // [length], increasing, >= 0: plane radial bins and exit bins
   uint64_t photons = 100000;
   uint64_t seed = 1;
   int batches = 16;  // >= 10 for standard errors
@@ -62,7 +62,7 @@ struct PlaneTally {
   // Diagnostic: the part of `angular` carried by photons that never travelled backward (cos theta <= 0)
   // before the crossing, the light a small-angle model describes.
   std::vector<Estimate> angular_forward_only;
-  Estimate unscattered;           // unscattered flux through the plane
+  Estimate unscattered;  // unscattered flux through the plane
 };
 
 struct PhotonMcResult {

@@ -1,10 +1,10 @@
 // The generalised forward propagator and the phase functions' Legendre moments (small_angle.h).
 #include "transport/small_angle.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
-
-#include <fmt/format.h>
 
 #include "core/math.h"
 #include "nimbus/error.h"
@@ -13,19 +13,22 @@ namespace nimbus {
 
 namespace {
 
-constexpr double kZStep = 0.25;   // spacing in q of the Z table
+constexpr double kZStep = 0.25;    // spacing in q of the Z table
 constexpr double kZDirect = 16.0;  // Z by direct Hankel quadrature below this q, by Hilb above
 
 // Four-point Gauss-Legendre on [-1, 1].
-constexpr double kGl4x[4] = {-0.8611363115940526, -0.3399810435848563, 0.3399810435848563, 0.8611363115940526};
+constexpr double kGl4x[4] = {-0.8611363115940526, -0.3399810435848563, 0.3399810435848563,
+                             0.8611363115940526};
 constexpr double kGl4w[4] = {0.3478548451374538, 0.6521451548625461, 0.6521451548625461, 0.3478548451374538};
 
 // Moments by quadrature in theta: panels no wider than 1.5 / l_cap so P_l never turns more than 1.5 rad
 // within one, nodes of a tabulated phase function kept as panel edges (its kinks).
 std::vector<double> quadrature_moments(const Phase& phase, double theta_max, int l_cap, double tol) {
   std::vector<double> edges;
-  if (const auto* t = std::get_if<TabulatedPhase>(&phase)) edges = t->theta;
-  else edges = {0.0, theta_max};
+  if (const auto* t = std::get_if<TabulatedPhase>(&phase))
+    edges = t->theta;
+  else
+    edges = {0.0, theta_max};
   std::vector<double> mu, wf;  // nodes cos theta, weights * phase * sin * 2 pi
   const double hmax = 1.5 / l_cap;
   for (size_t i = 0; i + 1 < edges.size(); ++i) {
@@ -76,7 +79,8 @@ void legendre_all(double mu, size_t n, std::vector<double>& p) {
   p.resize(n + 2);
   p[0] = 1.0;
   if (n + 2 > 1) p[1] = mu;
-  for (size_t l = 1; l + 1 < p.size(); ++l) p[l + 1] = ((2 * l + 1) * mu * p[l] - l * p[l - 1]) / double(l + 1);
+  for (size_t l = 1; l + 1 < p.size(); ++l)
+    p[l + 1] = ((2 * l + 1) * mu * p[l] - l * p[l - 1]) / double(l + 1);
 }
 
 // int_0^1 mu P_l(mu) dmu for l = 0..n (from I_l = int_0^1 P_l = [P_{l-1}(0) - P_{l+1}(0)] / (2l+1)
@@ -88,7 +92,8 @@ std::vector<double> half_range_mu_moments(size_t n) {
   I[0] = 1.0;
   for (size_t l = 1; l < I.size(); ++l) I[l] = (p0[l - 1] - p0[l + 1]) / double(2 * l + 1);
   std::vector<double> m(n + 1);
-  for (size_t l = 0; l <= n; ++l) m[l] = ((l + 1) * I[l + 1] + (l > 0 ? l * I[l - 1] : 0.0)) / double(2 * l + 1);
+  for (size_t l = 0; l <= n; ++l)
+    m[l] = ((l + 1) * I[l + 1] + (l > 0 ? l * I[l - 1] : 0.0)) / double(2 * l + 1);
   return m;
 }
 
@@ -96,12 +101,14 @@ std::vector<double> half_range_mu_moments(size_t n) {
 
 std::vector<double> phase_legendre_moments(const Phase& phase, double tol, int l_cap) {
   if (const auto* p = std::get_if<HgPhase>(&phase)) return geometric_moments(p->g, 1.0, 0.0, tol, l_cap);
-  if (const auto* p = std::get_if<DoubleHgPhase>(&phase)) return geometric_moments(p->g1, p->w, p->g2, tol, l_cap);
+  if (const auto* p = std::get_if<DoubleHgPhase>(&phase))
+    return geometric_moments(p->g1, p->w, p->g2, tol, l_cap);
   if (std::holds_alternative<IsotropicPhase>(phase)) return {1.0};
   if (const auto* p = std::get_if<GaussPhase>(&phase)) {
     // chi_l ~ exp(-l (l+1) theta2 / 2): the moments end near l = sqrt(-2 ln(tol) / theta2).
     const int l_need = int(std::sqrt(-2.0 * std::log(tol) / p->theta2)) + 16;
-    return quadrature_moments(phase, std::min(kPi, 40.0 * std::sqrt(p->theta2)), std::min(l_cap, l_need), tol);
+    return quadrature_moments(phase, std::min(kPi, 40.0 * std::sqrt(p->theta2)), std::min(l_cap, l_need),
+                              tol);
   }
   return quadrature_moments(phase, kPi, l_cap, tol);
 }
@@ -127,7 +134,8 @@ double z_hilb(const std::vector<double>& chi_l, double q) {
   const long i = long(std::floor(l));
   const double u = l - double(i);
   const double c0 = chi(i - 1), c1 = chi(i), c2 = chi(i + 1), c3 = chi(i + 2);
-  return c1 + 0.5 * u * (c2 - c0 + u * (2.0 * c0 - 5.0 * c1 + 4.0 * c2 - c3 + u * (3.0 * (c1 - c2) + c3 - c0)));
+  return c1 +
+         0.5 * u * (c2 - c0 + u * (2.0 * c0 - 5.0 * c1 + 4.0 * c2 - c3 + u * (3.0 * (c1 - c2) + c3 - c0)));
 }
 
 // Quadrature in theta of 2 pi P(theta) sin(theta) dtheta: geometric panels from 1e-6 to pi (and a
@@ -140,7 +148,8 @@ struct ThetaQuadrature {
 ThetaQuadrature theta_quadrature(const Phase& phase) {
   std::vector<double> edges{0.0};
   for (double th = 1e-6; th < kPi; th *= 1.02) edges.push_back(th);
-  if (const auto* tp = std::get_if<TabulatedPhase>(&phase)) edges.insert(edges.end(), tp->theta.begin(), tp->theta.end());
+  if (const auto* tp = std::get_if<TabulatedPhase>(&phase))
+    edges.insert(edges.end(), tp->theta.begin(), tp->theta.end());
   edges.push_back(kPi);
   std::sort(edges.begin(), edges.end());
   edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
@@ -160,7 +169,8 @@ ThetaQuadrature theta_quadrature(const Phase& phase) {
 // Z(q) = 2 pi int_0^pi P(theta) J0(q theta) sin(theta) dtheta, normalised to Z(0) = 1.
 double z_direct(const ThetaQuadrature& quad, double q) {
   double sum = 0.0;
-  for (size_t i = 0; i < quad.nodes.size(); ++i) sum += quad.weights[i] * std::cyl_bessel_j(0.0, q * quad.nodes[i]);
+  for (size_t i = 0; i < quad.nodes.size(); ++i)
+    sum += quad.weights[i] * std::cyl_bessel_j(0.0, q * quad.nodes[i]);
   return sum / quad.norm;
 }
 
@@ -200,7 +210,8 @@ ForwardPropagator::ForwardPropagator(const Phase& phase) : chi_(phase_legendre_m
 
 ForwardProfile ForwardPropagator::profile(double tau_s, double tau_a) const {
   if (!(tau_s >= 0.0) || !std::isfinite(tau_s) || !(tau_a >= 0.0) || !std::isfinite(tau_a))
-    throw Error(fmt::format("forward propagator: optical depths must be finite and >= 0 (tau_s={}, tau_a={})", tau_s, tau_a));
+    throw Error(fmt::format("forward propagator: optical depths must be finite and >= 0 (tau_s={}, tau_a={})",
+                            tau_s, tau_a));
   ForwardProfile p;
   p.tau_s_ = tau_s;
   p.tau_a_ = tau_a;
@@ -263,7 +274,8 @@ double ForwardProfile::zbar_and_z(double k, double* z_at) const {
   const double u = Q / kZStep - qi, h = kZStep;
   const double z0 = t[3 * i], m0 = t[3 * i + 1], c0 = t[3 * i + 2], z1 = t[3 * i + 3], m1 = t[3 * i + 4];
   const double u2 = u * u, u3 = u2 * u, u4 = u3 * u;
-  *z_at = (2 * u3 - 3 * u2 + 1) * z0 + (u3 - 2 * u2 + u) * h * m0 + (-2 * u3 + 3 * u2) * z1 + (u3 - u2) * h * m1;
+  *z_at =
+      (2 * u3 - 3 * u2 + 1) * z0 + (u3 - 2 * u2 + u) * h * m0 + (-2 * u3 + 3 * u2) * z1 + (u3 - u2) * h * m1;
   const double C = c0 + h * ((u - u3 + 0.5 * u4) * z0 + (0.5 * u2 - 2.0 * u3 / 3.0 + 0.25 * u4) * h * m0 +
                              (u3 - 0.5 * u4) * z1 + (0.25 * u4 - u3 / 3.0) * h * m1);
   return C / Q;
@@ -295,7 +307,8 @@ double ForwardProfile::radial_within(double r) const {
   const size_t nq = cumulative_z_->size() / 3;
   const bool asymptotic = X / r * tau_s_ > double(nq) * kZStep && spectrum(X / r) < 1e-3 * total_;
   auto f = [&](double x) {
-    return asymptotic ? spectrum(x / r) * std::cyl_bessel_j(1.0, x) : std::cyl_bessel_j(0.0, x) * spectrum_slope(x / r) / r;
+    return asymptotic ? spectrum(x / r) * std::cyl_bessel_j(1.0, x)
+                      : std::cyl_bessel_j(0.0, x) * spectrum_slope(x / r) / r;
   };
   double sum = 0.0;
   {
@@ -309,7 +322,8 @@ double ForwardProfile::radial_within(double r) const {
   {
     const int n = 2000;
     const double h = (X - 1.0) / n;
-    for (int i = 0; i <= n; ++i) sum += (i == 0 || i == n ? 1.0 : (i % 2 ? 4.0 : 2.0)) * f(1.0 + i * h) * h / 3.0;
+    for (int i = 0; i <= n; ++i)
+      sum += (i == 0 || i == n ? 1.0 : (i % 2 ? 4.0 : 2.0)) * f(1.0 + i * h) * h / 3.0;
   }
   if (asymptotic) {
     const double A = spectrum(X / r) * X / r;

@@ -54,8 +54,10 @@ class ForwardPropagator;
 // The scattered light after one path: what the renderer asks for.
 class ForwardProfile {
  public:
-  double total() const { return total_; }                // scattered unabsorbed power, all directions
-  double forward_flux() const { return forward_flux_; }  // its flux through the plane (cos-weighted, theta < pi/2)
+  double total() const { return total_; }  // scattered unabsorbed power, all directions
+  double forward_flux() const {
+    return forward_flux_;
+  }  // its flux through the plane (cos-weighted, theta < pi/2)
   // Plane-integrated radiance per steradian of the scattered light at polar angle theta [rad].
   double angular(double theta) const;
   // Scattered power within the cone of half-angle theta.
@@ -67,7 +69,7 @@ class ForwardProfile {
 
  private:
   friend class ForwardPropagator;
-  std::vector<double> f_;  // f_l
+  std::vector<double> f_;                                    // f_l
   std::shared_ptr<const std::vector<double>> cumulative_z_;  // int_0^(i) Z(q) dq at integer q
   double tau_s_ = 0.0, tau_a_ = 0.0, total_ = 0.0, forward_flux_ = 0.0;
   double spectrum(double k) const;        // R(k)

@@ -1,6 +1,8 @@
 // `nimbus beam` and `nimbus slab` run as a user would: the CSV layout and lines they promise, atomic
 // output, and exit code 2 with a clear message on bad arguments.
+#include <gtest/gtest.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
@@ -10,9 +12,6 @@
 #include <set>
 #include <sstream>
 #include <string>
-
-#include <gtest/gtest.h>
-#include <unistd.h>
 
 namespace {
 
@@ -43,8 +42,10 @@ std::filesystem::path temp_dir() {
 TEST(CliBeam, WritesTheDocumentedCsv) {
   const auto dir = temp_dir();
   const auto out = dir / "beam.csv";
-  const CliRun r = run("beam --phase hg:0.9 --albedo 0.99 --depths 1,3 --photons 2000 --theta-edges 0,0.01,0.1,1,3.14159 "
-                    "--r-edges 0,0.1,1,10 -o " + out.string());
+  const CliRun r =
+      run("beam --phase hg:0.9 --albedo 0.99 --depths 1,3 --photons 2000 --theta-edges 0,0.01,0.1,1,3.14159 "
+          "--r-edges 0,0.1,1,10 -o " +
+          out.string());
   ASSERT_EQ(r.rc, 0) << r.out;
   std::ifstream in(out);
   std::string line;
@@ -84,10 +85,12 @@ TEST(CliBeam, WritesTheDocumentedCsv) {
 }
 
 TEST(CliBeam, ModelsSubsetSlabAndSeed) {
-  const CliRun a = run("beam --phase gauss:0.01 --albedo 0.9 --depths 1 --geometry slab:2 --n 1.33 --photons 500 "
-                    "--models mc --theta-edges 0,0.1,3.14159 --r-edges 0,1 --seed 7");
-  const CliRun b = run("beam --phase gauss:0.01 --albedo 0.9 --depths 1 --geometry slab:2 --n 1.33 --photons 500 "
-                    "--models mc --theta-edges 0,0.1,3.14159 --r-edges 0,1 --seed 7");
+  const CliRun a =
+      run("beam --phase gauss:0.01 --albedo 0.9 --depths 1 --geometry slab:2 --n 1.33 --photons 500 "
+          "--models mc --theta-edges 0,0.1,3.14159 --r-edges 0,1 --seed 7");
+  const CliRun b =
+      run("beam --phase gauss:0.01 --albedo 0.9 --depths 1 --geometry slab:2 --n 1.33 --photons 500 "
+          "--models mc --theta-edges 0,0.1,3.14159 --r-edges 0,1 --seed 7");
   ASSERT_EQ(a.rc, 0) << a.out;
   EXPECT_EQ(a.out, b.out);
   EXPECT_EQ(a.out.find("gsa"), std::string::npos);
@@ -137,7 +140,8 @@ TEST(CliSlab, PrintsTheFiveTotalsThatBalance) {
   EXPECT_NEAR(v["specular"], std::pow(0.33 / 2.33, 2), 1e-7);
   EXPECT_NEAR(v["specular"] + v["diffuse_reflectance"] + v["transmittance"] + v["absorbed"], 1.0, 1e-3);
   EXPECT_LE(v["unscattered_transmittance"], v["transmittance"]);
-  const CliRun c = run("slab --mu-s 100 --mu-a 0.1 --g 0.9 --thickness 0.1 --photons 500 --csv --angle-bins 3 --r-bins 2");
+  const CliRun c =
+      run("slab --mu-s 100 --mu-a 0.1 --g 0.9 --thickness 0.1 --photons 500 --csv --angle-bins 3 --r-bins 2");
   ASSERT_EQ(c.rc, 0) << c.out;
   EXPECT_NE(c.out.find("side,quantity,lo,hi,value,stderr"), std::string::npos);
   EXPECT_NE(c.out.find("transmit,radial,"), std::string::npos);

@@ -5,9 +5,8 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <string>
-
 #include <nlohmann/json.hpp>
+#include <string>
 
 #include "nimbus/image.h"
 #include "support/scratch_dir.h"
@@ -29,14 +28,15 @@ TEST(CompareCli, PrintsJsonAndNamesMissingFiles) {
   write_exr(dir / "b.exr", b);
   const std::string cli = NIMBUS_CLI;
   const std::string cmd = cli + " compare " + (dir / "a.exr").string() + " " + (dir / "b.exr").string() +
-                          " --json --heatmap " + (dir / "h.png").string() + " > " + (dir / "out.json").string();
+                          " --json --heatmap " + (dir / "h.png").string() + " > " +
+                          (dir / "out.json").string();
   ASSERT_EQ(std::system(cmd.c_str()), 0);
   std::ifstream in(dir / "out.json");
   const auto j = nlohmann::json::parse(in);
   EXPECT_NEAR(j["mean_rel_error"].get<double>(), 0.25, 1e-6);
   EXPECT_TRUE(fs::exists(dir / "h.png"));
-  const int status = std::system((cli + " compare " + (dir / "nope.exr").string() + " " + (dir / "b.exr").string() +
-                                  " 2> " + (dir / "err.txt").string())
+  const int status = std::system((cli + " compare " + (dir / "nope.exr").string() + " " +
+                                  (dir / "b.exr").string() + " 2> " + (dir / "err.txt").string())
                                      .c_str());
   EXPECT_EQ(WEXITSTATUS(status), 2);
   std::ifstream err(dir / "err.txt");

@@ -1,7 +1,6 @@
 // nimbus render end to end: outputs and their headers, failed runs leave existing files alone, and
 // SIGINT writes a flagged partial image under its own name.
 #include <gtest/gtest.h>
-
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -19,15 +18,16 @@ namespace {
 
 namespace fs = std::filesystem;
 
-
 void write_scene(const fs::path& file, int size, int spp) {
   std::ofstream(file) << R"({"camera": {"position": [0, -4, 0], "look_at": [0, 0, 0], "up": [0, 0, 1],
-    "fov_y_deg": 30, "width": )" << size << R"(, "height": )" << size << R"(},
+    "fov_y_deg": 30, "width": )"
+                      << size << R"(, "height": )" << size << R"(},
     "media": [{"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1}, "sigma_s": 5.0,
                "phase": {"type": "hg", "g": 0.7}}],
     "lights": [{"type": "directional", "direction": [1, 1, -1], "irradiance": 2.0},
                {"type": "environment", "radiance": 0.1}],
-    "integrator": {"type": "pathtrace", "spp": )" << spp << "}}";
+    "integrator": {"type": "pathtrace", "spp": )"
+                      << spp << "}}";
 }
 
 int run(const std::string& args) {
@@ -66,7 +66,8 @@ TEST(RenderCli, FailedRunKeepsTheExistingOutput) {
   EXPECT_EQ(run("render " + (dir / "s.json").string() + " -o " + (dir / "out.exr").string() +
                 " --integrator nope --quiet 2>/dev/null"),
             2);
-  EXPECT_EQ(run("render " + (dir / "s.json").string() + " -o " + (dir / "out.tif").string() + " --quiet 2>/dev/null"),
+  EXPECT_EQ(run("render " + (dir / "s.json").string() + " -o " + (dir / "out.tif").string() +
+                " --quiet 2>/dev/null"),
             2);
   EXPECT_EQ(run("render " + (dir / "s.json").string() + " -o " + (dir / "nodir" / "x.exr").string() +
                 " --quiet 2>/dev/null"),
@@ -88,8 +89,8 @@ TEST(RenderCli, SigintWritesAFlaggedPartialImage) {
   const pid_t pid = fork();
   ASSERT_GE(pid, 0);
   if (pid == 0) {
-    execl(NIMBUS_CLI, NIMBUS_CLI, "render", (dir / "s.json").c_str(), "-o", (dir / "out.exr").c_str(), "--quiet",
-          "--threads", "1", static_cast<char*>(nullptr));
+    execl(NIMBUS_CLI, NIMBUS_CLI, "render", (dir / "s.json").c_str(), "-o", (dir / "out.exr").c_str(),
+          "--quiet", "--threads", "1", static_cast<char*>(nullptr));
     _exit(127);
   }
   std::this_thread::sleep_for(std::chrono::milliseconds(700));
@@ -116,7 +117,8 @@ TEST(RenderCli, ConvertWritesAPngAndRejectsBadInput) {
   ASSERT_EQ(run("convert " + (dir / "a.exr").string() + " " + (dir / "a.png").string() + " --exposure 1"), 0);
   EXPECT_GT(fs::file_size(dir / "a.png"), 0u);
   std::ofstream(dir / "bad.exr") << "not an exr";
-  EXPECT_EQ(run("convert " + (dir / "bad.exr").string() + " " + (dir / "b.png").string() + " 2>/dev/null"), 2);
+  EXPECT_EQ(run("convert " + (dir / "bad.exr").string() + " " + (dir / "b.png").string() + " 2>/dev/null"),
+            2);
   EXPECT_FALSE(fs::exists(dir / "b.png"));
   EXPECT_EQ(run("render " + (dir / "s.json").string() + " -o " + (dir / "c.exr").string() +
                 " --integrator mfs --quiet"),

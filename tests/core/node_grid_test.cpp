@@ -1,11 +1,12 @@
 // The node grid shared by the scatter grid, the beam grid and the shadow maps: its two layouts, its
 // indexing and its trilinear lookup (exact for linear functions, weights summing to 1, clamping).
+#include "core/node_grid.h"
+
 #include <gtest/gtest.h>
 
 #include <vector>
 
 #include "core/check.h"
-#include "core/node_grid.h"
 #include "core/rng.h"
 
 namespace nimbus {

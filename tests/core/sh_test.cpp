@@ -1,9 +1,9 @@
 // Real spherical harmonics: orthonormality by quadrature and the addition theorem.
+#include "core/sh.h"
+
 #include <gtest/gtest.h>
 
 #include <vector>
-
-#include "core/sh.h"
 
 namespace nimbus {
 namespace {

@@ -1,10 +1,11 @@
 // The `mfs` estimators alone (integrators/mfs_estimators.h): each checked against the equation of
 // docs/derivations.md it cites, without a scene.
-#include <cmath>
+#include "integrators/mfs_estimators.h"
 
 #include <gtest/gtest.h>
 
-#include "integrators/mfs_estimators.h"
+#include <cmath>
+
 #include "transport/small_angle.h"
 
 namespace nimbus {
@@ -45,14 +46,16 @@ TEST(MfsEstimators, CameraPathAccumulatesDepthsAndSpread) {  // eqs. D2, D10
   EXPECT_NEAR(cam.tau_p[2], 1.5 * z, 1e-12);
   EXPECT_NEAR(cam.theta_p[0], 0.03 * z, 1e-12);
   // Uniform sigma_theta: var(t) = sigma_theta int_0^z (t - s)^2 ds; at t = z, sigma_theta z^3 / 3.
-  EXPECT_NEAR(cam.lateral_spread(z), std::sqrt(0.03 * z * z * z / 3.0), 1e-4 * std::sqrt(0.03 * z * z * z / 3.0));
+  EXPECT_NEAR(cam.lateral_spread(z), std::sqrt(0.03 * z * z * z / 3.0),
+              1e-4 * std::sqrt(0.03 * z * z * z / 3.0));
   // The sample point half a step further, and the light-side choice of transmittance.
   const CameraPoint y = cam.at(k, 0.5, dt, false, false), yl = cam.at(k, 0.5, dt, true, false);
   EXPECT_NEAR(y.T_cam[0], std::exp(-0.5 * (z + 0.5 * dt)), 1e-12);
   EXPECT_NEAR(y.tau_p[0], 1.5 * (z + 0.5 * dt), 1e-12);
   EXPECT_EQ(yl.T_cam, yl.T_full);
   const CameraPoint yc = cam.at(k, 0.5, dt, false, true);  // with eq. D5
-  EXPECT_NEAR(yc.T_cam[0], y.T_cam[0] / std::cosh(std::sqrt(0.03 * (z + 0.5 * dt) * 0.5 * (z + 0.5 * dt))), 1e-12);
+  EXPECT_NEAR(yc.T_cam[0], y.T_cam[0] / std::cosh(std::sqrt(0.03 * (z + 0.5 * dt) * 0.5 * (z + 0.5 * dt))),
+              1e-12);
 }
 
 TEST(MfsEstimators, PeakOnlyBeamDepths) {  // eqs. D8, D9
@@ -97,7 +100,8 @@ TEST(MfsEstimators, EstimatorsAreTheirFormulas) {  // eqs. D7, D7b, D11
   for (int c = 0; c < 3; ++c) {
     EXPECT_DOUBLE_EQ(wide[c], E[c] * (1.0 - f) * split.wide_eff(tau_p[c] + tau_ps[c], mu) * T[c]);
     EXPECT_DOUBLE_EQ(peak[c], E[c] * f * split.peak_eff(tau_ps[c], mu) * T[c]);
-    EXPECT_NEAR(light[c], (1.0 - f) * E[c] * split.wide_eff(tau_ps[c], mu) * T[c] + peak[c], 1e-12 * light[c]);
+    EXPECT_NEAR(light[c], (1.0 - f) * E[c] * split.wide_eff(tau_ps[c], mu) * T[c] + peak[c],
+                1e-12 * light[c]);
   }
   // No spread on either side: the light side's scatter is the phase function itself.
   const Rgb at0 = light_side_scatter(Rgb(1.0), f, split, mu, Rgb(0.0), Rgb(1.0));

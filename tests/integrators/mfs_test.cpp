@@ -1,13 +1,14 @@
 // `mfs` and `octave`: analytic limits of the phase split, the single-scattering limits of both
 // integrators, option parsing and determinism. (Accuracy against pathtrace: validation/mfs_validation.py.)
-#include <cstdio>
-#include <cstring>
+#include "integrators/mfs.h"
 
 #include <gtest/gtest.h>
 
-#include "integrators/mfs.h"
-#include "integrators/registry.h"
+#include <cstdio>
+#include <cstring>
+
 #include "integrators/octave.h"
+#include "integrators/registry.h"
 #include "integrators/shadow_map.h"
 #include "integrators/single.h"
 #include "nimbus/error.h"
@@ -33,14 +34,16 @@ double sphere_integral(F&& f) {
 }
 
 TEST(PhaseSplit, PartsAreNormalisedAndRecombine) {
-  for (const Phase& phase : {Phase(HgPhase{0.85}), Phase(DoubleHgPhase{0.9, -0.3, 0.8}), Phase(HgPhase{0.5})}) {
+  for (const Phase& phase :
+       {Phase(HgPhase{0.85}), Phase(DoubleHgPhase{0.9, -0.3, 0.8}), Phase(HgPhase{0.5})}) {
     const PhaseSplit split(phase, auto_peak_fraction(phase));
     const double f = split.f();
     EXPECT_NEAR(f, auto_peak_fraction(phase), 2e-3) << phase_describe(phase);
     EXPECT_NEAR(sphere_integral([&](double mu) { return split.wide(mu); }), 1.0, 2e-3);
     EXPECT_NEAR(sphere_integral([&](double mu) { return split.peak(mu); }), 1.0, 2e-3);
     for (double mu : {-0.9, 0.0, 0.5, 0.95, 0.999}) {
-      EXPECT_NEAR(f * split.peak(mu) + (1 - f) * split.wide(mu), phase_eval(phase, mu), 1e-9 * phase_eval(phase, mu) + 1e-12);
+      EXPECT_NEAR(f * split.peak(mu) + (1 - f) * split.wide(mu), phase_eval(phase, mu),
+                  1e-9 * phase_eval(phase, mu) + 1e-12);
       EXPECT_GE(split.peak(mu), 0.0);
       EXPECT_GE(split.wide(mu), 0.0);
     }
@@ -65,14 +68,15 @@ TEST(PhaseSplit, NoPeakIsThePhaseFunction) {
   EXPECT_EQ(split.f(), 0.0);
   for (double tau : {0.0, 5.0})
     for (double mu : {-1.0, 0.0, 0.7, 0.99})
-      EXPECT_NEAR(split.wide_eff(tau, mu), phase_eval(phase, mu), 0.01 * phase_eval(phase, mu)) << tau << " " << mu;
+      EXPECT_NEAR(split.wide_eff(tau, mu), phase_eval(phase, mu), 0.01 * phase_eval(phase, mu))
+          << tau << " " << mu;
 }
 
 std::string sphere_scene(double sigma_s, double sigma_a, double g, bool env) {
   return "{" + test::camera_json() + R"(,
     "media": [{"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1}, "sigma_s": )" +
-         std::to_string(sigma_s) + R"(, "sigma_a": )" + std::to_string(sigma_a) + R"(, "phase": {"type": "hg", "g": )" +
-         std::to_string(g) + R"(}}],
+         std::to_string(sigma_s) + R"(, "sigma_a": )" + std::to_string(sigma_a) +
+         R"(, "phase": {"type": "hg", "g": )" + std::to_string(g) + R"(}}],
     "lights": [{"type": "directional", "direction": [0.6, 1, -0.4], "irradiance": 2.0},
                {"type": "point", "position": [1.5, -2, 1], "intensity": 3.0})" +
          (env ? R"(, {"type": "environment", "radiance": [0.2, 0.3, 0.5]})" : "") + "]}";
@@ -164,8 +168,10 @@ TEST(Mfs, OptionsAreValidatedStrictly) {
   EXPECT_THROW(parse(R"({"peak_fraction": 1.5})"), Error);
   EXPECT_NO_THROW(parse(R"({"large_angle_scatters": 3, "photons": 1000, "scatter_grid_resolution": 16})"));
   EXPECT_NO_THROW(parse(R"({"large_angle_scatters": "all"})"));
-  EXPECT_NO_THROW(parse(R"({"photon_transport": "similarity", "scatter_grid_bands": 2, "path_lengthening": true})"));
-  EXPECT_NO_THROW(parse(R"({"forward_side": "light", "photon_transport": "exact", "light_path": "forward"})"));
+  EXPECT_NO_THROW(
+      parse(R"({"photon_transport": "similarity", "scatter_grid_bands": 2, "path_lengthening": true})"));
+  EXPECT_NO_THROW(
+      parse(R"({"forward_side": "light", "photon_transport": "exact", "light_path": "forward"})"));
   // Conflicting fields are errors that name both (forward_side "light" would override them).
   auto message = [&](const std::string& opts) {
     try {
@@ -176,11 +182,13 @@ TEST(Mfs, OptionsAreValidatedStrictly) {
     return std::string();
   };
   EXPECT_EQ(message(R"({"forward_side": "light", "photon_transport": "similarity"})"),
-            "t.json: /integrator/photon_transport: \"similarity\" conflicts with /integrator/forward_side \"light\" "
+            "t.json: /integrator/photon_transport: \"similarity\" conflicts with /integrator/forward_side "
+            "\"light\" "
             "(the light side needs \"exact\")");
-  EXPECT_EQ(message(R"({"light_path": "beer_lambert", "forward_side": "light"})"),
-            "t.json: /integrator/light_path: \"beer_lambert\" conflicts with /integrator/forward_side \"light\" "
-            "(the light side needs \"forward\")");
+  EXPECT_EQ(
+      message(R"({"light_path": "beer_lambert", "forward_side": "light"})"),
+      "t.json: /integrator/light_path: \"beer_lambert\" conflicts with /integrator/forward_side \"light\" "
+      "(the light side needs \"forward\")");
   EXPECT_THROW(parse(R"({"path_lengthening": 1})"), Error);
   EXPECT_NO_THROW(parse(R"({"beam_photons": 0})"));
   EXPECT_NO_THROW(parse(R"({"beam_photons": 100000})"));
@@ -201,12 +209,14 @@ TEST(Mfs, OptionsAreValidatedStrictly) {
   EXPECT_THROW(parse(R"({"scatter_grid_resolution": 2})"), Error);
   EXPECT_NO_THROW(parse(R"({"scatter_grid_resolution": "auto"})"));
   EXPECT_THROW(parse(R"({"scatter_grid_resolution": "fine"})"), Error);
-  EXPECT_NO_THROW(validate_integrator_options("octave", nlohmann::json::parse(R"({"octaves": 6, "a": 0.6, "b": 0.4, "c": 0.7})"), "t"));
+  EXPECT_NO_THROW(validate_integrator_options(
+      "octave", nlohmann::json::parse(R"({"octaves": 6, "a": 0.6, "b": 0.4, "c": 0.7})"), "t"));
   EXPECT_THROW(validate_integrator_options("octave", nlohmann::json::parse(R"({"octaves": 0})"), "t"), Error);
   EXPECT_THROW(validate_integrator_options("octave", nlohmann::json::parse(R"({"d": 0.5})"), "t"), Error);
   // Through the scene parser.
   EXPECT_THROW(test::scene_from_json("{" + test::camera_json() + R"(, "lights": [],
-      "integrator": {"type": "mfs", "bogus": 1}})"), Error);
+      "integrator": {"type": "mfs", "bogus": 1}})"),
+               Error);
 }
 
 TEST(Mfs, BitIdenticalForAnyThreadCount) {
@@ -216,14 +226,16 @@ TEST(Mfs, BitIdenticalForAnyThreadCount) {
                  "phase": {"type": "hg", "g": 0.8}}],
       "lights": [{"type": "directional", "direction": [1, 1, -1], "irradiance": 1.0},
                  {"type": "environment", "radiance": 0.2}],
-      "integrator": {"type": ")" + std::string(type) + R"(", "spp": 2, "seed": 42}})");
+      "integrator": {"type": ")" + std::string(type) +
+                                              R"(", "spp": 2, "seed": 42}})");
     RenderOptions one, two;
     one.threads = 1;
     two.threads = 2;
     two.tile_size = 5;
     const RenderResult a = render(scene, one), b = render(scene, two);
     ASSERT_EQ(a.image.rgb.size(), b.image.rgb.size());
-    EXPECT_EQ(0, std::memcmp(a.image.rgb.data(), b.image.rgb.data(), a.image.rgb.size() * sizeof(float))) << type;
+    EXPECT_EQ(0, std::memcmp(a.image.rgb.data(), b.image.rgb.data(), a.image.rgb.size() * sizeof(float)))
+        << type;
     EXPECT_EQ(a.nonfinite_samples, 0);
   }
 }
@@ -260,8 +272,8 @@ TEST(Mfs, IsotropicMediumMatchesPathTracerOrderByOrder) {
     scene.integrator.options = {{"tau_step", 0.05}};
     const RenderResult single = render(scene, opt);
     const Rgb a = image_mean(mfs.image), b = image_mean(ref.image), s1 = image_mean(single.image);
-    std::printf("K %d: mfs %.5f %.5f %.5f  pathtrace %.5f %.5f %.5f  single %.5f\n", K, a[0], a[1], a[2], b[0], b[1],
-                b[2], s1[0]);
+    std::printf("K %d: mfs %.5f %.5f %.5f  pathtrace %.5f %.5f %.5f  single %.5f\n", K, a[0], a[1], a[2],
+                b[0], b[1], b[2], s1[0]);
     for (int c = 0; c < 3; ++c) {
       // The higher orders are a sizeable part of the image (the environment dominates blue) ...
       EXPECT_GT(b[c] - s1[c], 0.03 * b[c]) << "K " << K << " channel " << c;
@@ -334,8 +346,9 @@ TEST(Mfs, BeamGridReproducesTheStraightBeamWithoutDeflection) {
   MfsIntegrator mfs(ctx, ms);
   ASSERT_NE(mfs.beam_grid(), nullptr);
   const Bounds box{Vec3(-1.0), Vec3(1.0)};
-  const TransmittanceGrid maps[2] = {TransmittanceGrid(ctx.media, ctx.majorants, ctx.lights[0], 64, 0.25, {0.81}),
-                                     TransmittanceGrid(ctx.media, ctx.majorants, ctx.lights[1], 64, 0.25, {0.81})};
+  const TransmittanceGrid maps[2] = {
+      TransmittanceGrid(ctx.media, ctx.majorants, ctx.lights[0], 64, 0.25, {0.81}),
+      TransmittanceGrid(ctx.media, ctx.majorants, ctx.lights[1], 64, 0.25, {0.81})};
   Rng rng(3, 0);
   double err_map = 0.0, err_traced = 0.0;
   int n = 0;
@@ -450,7 +463,8 @@ TEST(Mfs, FilteredLookupsOfTheScatterGrid) {
   for (int i = 0; i < 100; ++i) {
     const Vec3 p(1.6 * rng.uniform() - 0.8, 1.6 * rng.uniform() - 0.8, 1.6 * rng.uniform() - 0.8);
     const Vec3 w = normalize(Vec3(rng.uniform() - 0.5, rng.uniform() - 0.5, rng.uniform() - 0.5));
-    const Rgb a = mfs.scatter_grid()->scattered(p, w, chi), b = mfs.scatter_grid()->scattered_filtered(p, w, chi, 0.0);
+    const Rgb a = mfs.scatter_grid()->scattered(p, w, chi),
+              b = mfs.scatter_grid()->scattered_filtered(p, w, chi, 0.0);
     for (int c = 0; c < 3; ++c) EXPECT_EQ(a[c], b[c]);
   }
   scene.integrator.type = "mfs";
@@ -478,8 +492,8 @@ TEST(Mfs, PointLightAndChromaticMediumMatchPathTracer) {
   scene.integrator.spp = 4;
   scene.integrator.options = {{"tau_step", 0.05}, {"photons", 1 << 18}, {"scatter_grid_resolution", 24}};
   const Rgb m = image_mean(render(scene, RenderOptions{}).image);
-  std::printf("point light, chromatic: mfs %.5f %.5f %.5f pathtrace %.5f %.5f %.5f\n", m[0], m[1], m[2], ref[0],
-              ref[1], ref[2]);
+  std::printf("point light, chromatic: mfs %.5f %.5f %.5f pathtrace %.5f %.5f %.5f\n", m[0], m[1], m[2],
+              ref[0], ref[1], ref[2]);
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(m[c], ref[c], 0.03 * ref[c]) << c;
 }
 
@@ -491,8 +505,10 @@ TEST(Mfs, MoreWideScattersAddLight) {
     "integrator": {"type": "mfs", "spp": 2, "photons": 100000}})");
   double previous = 0.0;
   for (int K : {0, 1, 2, 3, -1}) {
-    if (K >= 0) scene.integrator.options["large_angle_scatters"] = K;
-    else scene.integrator.options.erase("large_angle_scatters");
+    if (K >= 0)
+      scene.integrator.options["large_angle_scatters"] = K;
+    else
+      scene.integrator.options.erase("large_angle_scatters");
     const double m = image_mean(render(scene, RenderOptions{}).image)[0];
     EXPECT_GT(m, previous * 1.01) << K;
     previous = m;

@@ -1,14 +1,15 @@
 // The reference path tracer against analytic answers and independent quadratures. Tolerances come
 // from the estimated standard error of each Monte Carlo mean (5 sigma), never from stored results.
+#include "integrators/pathtrace.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstring>
 
-#include "integrators/pathtrace.h"
 #include "integrators/registry.h"
-#include "nimbus/error.h"
 #include "integrators/tracking.h"
+#include "nimbus/error.h"
 #include "nimbus/render.h"
 #include "scene/lights.h"
 #include "support/scenes.h"
@@ -107,7 +108,8 @@ TEST(PathTracer, AbsorbingSlabTransmitsTheEnvironment) {
   const Vec3 o(0, -3, 0), d = normalize(Vec3(0.2, 1, 0.1));
   const double chord = 1.0 / d.y;
   const auto s = estimate(pt, o, d, 20000);
-  expect_within_noise(s, Rgb(1 * std::exp(-0.3 * chord), 2 * std::exp(-1.0 * chord), 3 * std::exp(-2.5 * chord)));
+  expect_within_noise(
+      s, Rgb(1 * std::exp(-0.3 * chord), 2 * std::exp(-1.0 * chord), 3 * std::exp(-2.5 * chord)));
 }
 
 // The white furnace: an albedo-1 medium inside a uniform environment shows exactly the environment,
@@ -166,8 +168,10 @@ TEST(PathTracer, WideScatterLimitPartitionsTheRadiance) {
   }
   PathTraceSettings all;
   all.max_wide_scatters = 1 << 20;
-  const auto full = estimate(PathTracer(ctx, 0), o, d, n, 3), limited = estimate(PathTracer(ctx, 0, all), o, d, n, 4);
-  EXPECT_NEAR(full.c[0].mean, limited.c[0].mean, 5.0 * std::hypot(full.c[0].stderr_mean(), limited.c[0].stderr_mean()));
+  const auto full = estimate(PathTracer(ctx, 0), o, d, n, 3),
+             limited = estimate(PathTracer(ctx, 0, all), o, d, n, 4);
+  EXPECT_NEAR(full.c[0].mean, limited.c[0].mean,
+              5.0 * std::hypot(full.c[0].stderr_mean(), limited.c[0].stderr_mean()));
   double previous = 0.0;
   for (int K : {0, 1, 2, 4}) {
     PathTraceSettings w;
@@ -177,8 +181,9 @@ TEST(PathTracer, WideScatterLimitPartitionsTheRadiance) {
     EXPECT_LT(s.c[0].mean, full.c[0].mean + 5.0 * full.c[0].stderr_mean()) << K;
     previous = s.c[0].mean;
   }
-  EXPECT_THROW(validate_integrator_options("pathtrace", nlohmann::json::parse(R"({"max_wide_scatters": -1})"), "t"),
-               Error);
+  EXPECT_THROW(
+      validate_integrator_options("pathtrace", nlohmann::json::parse(R"({"max_wide_scatters": -1})"), "t"),
+      Error);
   EXPECT_NO_THROW(validate_integrator_options(
       "pathtrace", nlohmann::json::parse(R"({"max_wide_scatters": 2, "peak_fraction": "auto"})"), "t"));
 }
@@ -249,7 +254,8 @@ TEST(PathTracer, PointLightSingleScatteringMatchesQuadrature) {
   const SceneContext ctx(scene);
   const PathTracer pt(ctx, 1);
   const Vec3 o(0, -4, 0), d = normalize(Vec3(0.1, 1, 0.05)), light(0, 0, 3);
-  const double b = dot(o, d), c = dot(o, o) - 1.0, t0 = -b - std::sqrt(b * b - c), t1 = -b + std::sqrt(b * b - c);
+  const double b = dot(o, d), c = dot(o, o) - 1.0, t0 = -b - std::sqrt(b * b - c),
+               t1 = -b + std::sqrt(b * b - c);
   double exact = 0.0;
   const int n = 20000;
   for (int i = 0; i < n; ++i) {

@@ -1,11 +1,12 @@
 // The shared photon tracer of the scatter and beam grids: the batches and the work budget, the
 // rejection sampler's explicit failure, and no failures in the grids `mfs` builds for a usual scene.
+#include "integrators/photon_tracer.h"
+
 #include <gtest/gtest.h>
 
 #include <atomic>
 
 #include "integrators/mfs.h"
-#include "integrators/photon_tracer.h"
 #include "support/scenes.h"
 
 namespace nimbus {
@@ -65,7 +66,8 @@ TEST(PhotonTracer, GridsOfAUsualSceneHaveNoRejectionFailures) {
                "phase": {"type": "hg", "g": 0.8}}],
     "lights": [{"type": "directional", "direction": [-1, 0.3, 0.2], "irradiance": 1.0}]})");
   const SceneContext ctx(scene);
-  const nlohmann::json options = {{"photon_transport", "similarity"}, {"photons", 1 << 14}, {"beam_photons", 1 << 12}};
+  const nlohmann::json options = {
+      {"photon_transport", "similarity"}, {"photons", 1 << 14}, {"beam_photons", 1 << 12}};
   const MfsIntegrator mfs(ctx, mfs_settings_from_json(options, "test"));
   ASSERT_NE(mfs.scatter_grid(), nullptr);
   ASSERT_NE(mfs.beam_grid(), nullptr);

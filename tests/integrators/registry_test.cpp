@@ -1,11 +1,12 @@
 // The integrator registry: every integrator's settings round-trip through JSON, unknown fields name the
 // known ones, and the names are listed once.
+#include "integrators/registry.h"
+
 #include <gtest/gtest.h>
 
 #include "integrators/mfs.h"
 #include "integrators/octave.h"
 #include "integrators/pathtrace.h"
-#include "integrators/registry.h"
 #include "integrators/single.h"
 #include "nimbus/error.h"
 #include "nimbus/render.h"
@@ -24,7 +25,8 @@ std::string error_of(const std::function<void()>& f) {
 
 // from_json(to_json(from_json(j))) writes the same JSON as from_json(j): nothing is lost or renamed.
 template <typename Settings>
-void expect_round_trip(Settings (*parse)(const nlohmann::json&, const std::string&), const nlohmann::json& j) {
+void expect_round_trip(Settings (*parse)(const nlohmann::json&, const std::string&),
+                       const nlohmann::json& j) {
   const nlohmann::json once = to_json(parse(j, "t.json"));
   const nlohmann::json twice = to_json(parse(once, "t.json"));
   EXPECT_EQ(once, twice) << j.dump();
@@ -45,8 +47,9 @@ TEST(Registry, SettingsRoundTripThroughJson) {
                                                  {"transmittance", "shadow_map"},
                                                  {"shadow_map_resolution", 32}});
   expect_round_trip(&octave_settings_from_json, nlohmann::json::object());
-  expect_round_trip(&octave_settings_from_json,
-                    {{"octaves", 6}, {"a", 0.6}, {"b", 0.4}, {"c", 0.7}, {"tau_step", 0.2}, {"shadow_map_resolution", 16}});
+  expect_round_trip(
+      &octave_settings_from_json,
+      {{"octaves", 6}, {"a", 0.6}, {"b", 0.4}, {"c", 0.7}, {"tau_step", 0.2}, {"shadow_map_resolution", 16}});
   expect_round_trip(&mfs_settings_from_json, nlohmann::json::object());
   expect_round_trip(&mfs_settings_from_json, {{"tau_step", 0.2},
                                               {"step_growth", 0.5},
@@ -64,8 +67,9 @@ TEST(Registry, SettingsRoundTripThroughJson) {
                                               {"path_lengthening", true},
                                               {"filtered_lookups", true},
                                               {"shadow_map_resolution", 32}});
-  expect_round_trip(&mfs_settings_from_json, {{"peak_fraction", "auto"}, {"large_angle_scatters", "all"},
-                                              {"scatter_grid_resolution", "auto"}});
+  expect_round_trip(
+      &mfs_settings_from_json,
+      {{"peak_fraction", "auto"}, {"large_angle_scatters", "all"}, {"scatter_grid_resolution", "auto"}});
 }
 
 TEST(Registry, DefaultsAreWrittenOut) {
@@ -78,9 +82,13 @@ TEST(Registry, DefaultsAreWrittenOut) {
 }
 
 TEST(Registry, UnknownFieldsAndNamesAreErrors) {
-  EXPECT_EQ(error_of([] { validate_integrator_options("pathtrace", {{"tau_step", 0.1}}, "s.json"); }),
+  EXPECT_EQ(error_of([] {
+              validate_integrator_options("pathtrace", {{"tau_step", 0.1}}, "s.json");
+            }),
             "s.json: /integrator/tau_step: unknown field (known here: max_wide_scatters, peak_fraction)");
-  EXPECT_EQ(error_of([] { validate_integrator_options("single", {{"transmittance", "exact"}}, "s.json"); }),
+  EXPECT_EQ(error_of([] {
+              validate_integrator_options("single", {{"transmittance", "exact"}}, "s.json");
+            }),
             "s.json: /integrator/transmittance: must be \"ratio\" or \"shadow_map\"");
   EXPECT_EQ(error_of([] { find_integrator("volpath"); }),
             "unknown integrator 'volpath' (known: pathtrace, single, mfs, octave)");

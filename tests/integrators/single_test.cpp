@@ -1,8 +1,9 @@
 // `single` against the reference restricted to one scattering event (pathtrace, max_events = 1).
+#include "integrators/single.h"
+
 #include <gtest/gtest.h>
 
 #include "integrators/pathtrace.h"
-#include "integrators/single.h"
 #include "support/scenes.h"
 #include "support/stats.h"
 

@@ -3,6 +3,7 @@
 // integrator), and the limits that used to be checked late or not by name are errors that name the
 // file and the field (spp above kMaxSpp, more than 16 media, grids with no active voxels, degenerate
 // camera frames). The outcome of each is documented in docs/scene-format.md ("Edge cases").
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <nanovdb/util/IO.h>
 #include <nanovdb/util/OpenToNanoVDB.h>
@@ -14,8 +15,6 @@
 #include <cstdlib>
 #include <fstream>
 
-#include <fmt/format.h>
-
 #include "io/vdb_test_util.h"
 #include "nimbus/error.h"
 #include "nimbus/render.h"
@@ -25,7 +24,8 @@ namespace nimbus {
 namespace {
 
 // A sphere of radius 1 at the origin (albedo ~0.95, forward scattering), sun, sky and a point light.
-std::string sphere_scene(const std::string& camera_pos, const std::string& point_pos, const std::string& integrator) {
+std::string sphere_scene(const std::string& camera_pos, const std::string& point_pos,
+                         const std::string& integrator) {
   return fmt::format(R"({{"camera": {{"position": {}, "look_at": [0, 1, 0], "up": [0, 0, 1], "fov_y_deg": 60,
       "width": 8, "height": 8}},
     "media": [{{"shape": {{"type": "sphere", "center": [0, 0, 0], "radius": 1}}, "sigma_s": 3.0,
@@ -110,9 +110,9 @@ TEST(BadInput, SppAboveTheLimitNamesTheField) {
   // The CLI refuses it while parsing its arguments, naming the option, with exit code 2.
   test::ScratchDir dir("bad_spp");
   std::ofstream(dir / "s.json") << doc.dump();
-  const std::string cmd = fmt::format("{} render {} -o {} --spp {} --quiet 2> {}", NIMBUS_CLI,
-                                      (dir / "s.json").string(), (dir / "o.exr").string(), kMaxSpp + 1,
-                                      (dir / "err.txt").string());
+  const std::string cmd =
+      fmt::format("{} render {} -o {} --spp {} --quiet 2> {}", NIMBUS_CLI, (dir / "s.json").string(),
+                  (dir / "o.exr").string(), kMaxSpp + 1, (dir / "err.txt").string());
   const int status = std::system(cmd.c_str());
   ASSERT_TRUE(WIFEXITED(status));
   EXPECT_EQ(WEXITSTATUS(status), 2);
@@ -146,7 +146,8 @@ TEST(BadInput, GridsWithoutActiveVoxelsAreErrors) {
   nlohmann::json doc = small_scene();
   doc["media"][0]["shape"] = {{"type", "vdb"}, {"file", (dir / "empty.nvdb").string()}, {"scale", 1.0}};
   const std::string msg = parse_error(doc);
-  EXPECT_EQ(msg.rfind("scene.json: /media/0/shape/file: " + (dir / "empty.nvdb").string() + ": ", 0), 0u) << msg;
+  EXPECT_EQ(msg.rfind("scene.json: /media/0/shape/file: " + (dir / "empty.nvdb").string() + ": ", 0), 0u)
+      << msg;
   // A procedural cloud has at least 8 voxels along each axis.
   doc["media"][0]["shape"] = {{"type", "cloud"}, {"radius", 1}, {"resolution", 0}};
   EXPECT_EQ(parse_error(doc), "scene.json: /media/0/shape/resolution: must be >= 8");
@@ -176,8 +177,10 @@ TEST(BadInput, DegenerateCameraFramesAreErrors) {
   doc["camera"]["look_at"] = doc["camera"]["position"];
   EXPECT_EQ(parse_error(doc), "scene.json: /camera/look_at: must differ from position");
   doc = small_scene();
-  const std::string parallel = "scene.json: /camera/up: must not be parallel to the view direction (look_at - position)";
-  for (const auto& up : {nlohmann::json{0, -3, 0}, nlohmann::json{0, 1, 1e-9}}) {  // anti-parallel, nearly parallel
+  const std::string parallel =
+      "scene.json: /camera/up: must not be parallel to the view direction (look_at - position)";
+  for (const auto& up :
+       {nlohmann::json{0, -3, 0}, nlohmann::json{0, 1, 1e-9}}) {  // anti-parallel, nearly parallel
     doc["camera"]["up"] = up;
     EXPECT_EQ(parse_error(doc), parallel) << up;
   }

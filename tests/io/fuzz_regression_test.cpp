@@ -35,9 +35,7 @@ void expect_clean_error(const char* name, double seconds = 5.0) {
 
 // A mutated tiny .vdb whose tree claims billions of tiles: OpenVDB read on from the failed stream
 // for minutes (52 s under the fuzzer's sanitizers). Now the stream throws at the first short read.
-TEST(FuzzRegression, OpenVdbCorruptCountDoesNotSpin) {
-  expect_clean_error("vdb_timeout_tile_count.vdb");
-}
+TEST(FuzzRegression, OpenVdbCorruptCountDoesNotSpin) { expect_clean_error("vdb_timeout_tile_count.vdb"); }
 
 // A NanoVDB grid type beyond GridType::End: nanovdb::toStr read past the end of its name table
 // while the error message was formatted (UBSan: index out of bounds).
@@ -127,7 +125,8 @@ TEST(FuzzRegression, StreamedOpenVdbDescriptorLengthIsChecked) {
   getrusage(RUSAGE_SELF, &after);
   EXPECT_LT(after.ru_maxrss - before.ru_maxrss, 200 * 1024) << "KB of peak memory added";
   const std::string msg = test::load_error(fuzz_input("vdb_stream_descriptor_name_length.vdb"));
-  EXPECT_NE(msg.find("corrupt OpenVDB file: instance parent needs 861877343 bytes"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("corrupt OpenVDB file: instance parent needs 861877343 bytes"), std::string::npos)
+      << msg;
 }
 
 }  // namespace

@@ -1,7 +1,8 @@
 // Images: EXR round trips, sRGB encoding, atomic writes that never lose an existing file, and the
 // comparison metrics against hand-computed values.
-#include <gtest/gtest.h>
+#include "nimbus/image.h"
 
+#include <gtest/gtest.h>
 #include <png.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -15,15 +16,12 @@
 #include "io/atomic_file.h"
 #include "nimbus/compare.h"
 #include "nimbus/error.h"
-#include "nimbus/image.h"
 #include "support/scratch_dir.h"
-
 
 namespace nimbus {
 namespace {
 
 namespace fs = std::filesystem;
-
 
 Image ramp(int w, int h) {
   Image img(w, h);
@@ -55,7 +53,7 @@ TEST(Image, ExrRoundTripIsExactWithMetadata) {
 TEST(Image, SrgbEncoding) {
   EXPECT_EQ(srgb_encode(0.0), 0.0);
   EXPECT_DOUBLE_EQ(srgb_encode(1.0), 1.0);
-  EXPECT_NEAR(srgb_encode(0.5) * 255.0, 187.52, 0.01);  // the textbook 188
+  EXPECT_NEAR(srgb_encode(0.5) * 255.0, 187.52, 0.01);           // the textbook 188
   EXPECT_NEAR(srgb_encode(0.0031308), 12.92 * 0.0031308, 1e-6);  // both branches meet
   EXPECT_NEAR(srgb_encode(0.0031308 + 1e-9), 12.92 * 0.0031308, 1e-6);
 }
@@ -86,10 +84,11 @@ TEST(Image, FailedWritesKeepTheOldFileAndLeaveNoTemporaries) {
   const fs::path f = dir / "keep.exr";
   write_exr(f, ramp(5, 5));
   const auto before = fs::file_size(f);
-  EXPECT_THROW(atomic_write(f, [](const fs::path& tmp) {
-                 std::ofstream(tmp) << "half";
-                 throw std::runtime_error("disk on fire");
-               }),
+  EXPECT_THROW(atomic_write(f,
+                            [](const fs::path& tmp) {
+                              std::ofstream(tmp) << "half";
+                              throw std::runtime_error("disk on fire");
+                            }),
                Error);
   EXPECT_EQ(fs::file_size(f), before);
   EXPECT_NO_THROW(read_exr(f));

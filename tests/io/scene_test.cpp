@@ -71,20 +71,27 @@ TEST(Scene, BadInputCatalogue) {
   };
   const std::vector<Case> cases = {
       {"/media/0/sigma_s", -1.0, false, "scene.json: /media/0/sigma_s: must be >= 0"},
-      {"/media/1/sigma_s", json::array({1.0, -2.0, 1.0}), false, "scene.json: /media/1/sigma_s/1: must be >= 0"},
-      {"/media/0/sigma_a", "a lot", false, "scene.json: /media/0/sigma_a: must be a number or an array [r, g, b]"},
+      {"/media/1/sigma_s", json::array({1.0, -2.0, 1.0}), false,
+       "scene.json: /media/1/sigma_s/1: must be >= 0"},
+      {"/media/0/sigma_a", "a lot", false,
+       "scene.json: /media/0/sigma_a: must be a number or an array [r, g, b]"},
       {"/media/0/sigma_s", nullptr, true, "scene.json: /media/0/sigma_s: required field is missing"},
       {"/media/0/phase/g", 1.0, false, "scene.json: /media/0/phase/g: must satisfy |g| < 1"},
       {"/media/0/phase/g", -1.5, false, "scene.json: /media/0/phase/g: must satisfy |g| < 1"},
       {"/media/0/phase/type", "rayleigh", false,
-       "scene.json: /media/0/phase/type: unknown phase function 'rayleigh' (known: isotropic, hg, double_hg, gauss)"},
+       "scene.json: /media/0/phase/type: unknown phase function 'rayleigh' (known: isotropic, hg, double_hg, "
+       "gauss)"},
       {"/media/0/shape/radius", 0.0, false, "scene.json: /media/0/shape/radius: must be > 0"},
       {"/media/0/shape/type", "torus", false,
        "scene.json: /media/0/shape/type: unknown shape 'torus' (known: sphere, box, vdb, cloud)"},
-      {"/media/1/shape/max", json::array({1, -2, 1}), false, "scene.json: /media/1/shape/max: must exceed min on every axis"},
-      {"/media/0/sigm_s", 1.0, false, "scene.json: /media/0/sigm_s: unknown field (known here: phase, shape, sigma_a, sigma_s)"},
-      {"/lights/0/direction", json::array({0, 0, 0}), false, "scene.json: /lights/0/direction: must have non-zero length"},
-      {"/lights/0/direction", json::array({0, 1}), false, "scene.json: /lights/0/direction: must be an array of 3 numbers"},
+      {"/media/1/shape/max", json::array({1, -2, 1}), false,
+       "scene.json: /media/1/shape/max: must exceed min on every axis"},
+      {"/media/0/sigm_s", 1.0, false,
+       "scene.json: /media/0/sigm_s: unknown field (known here: phase, shape, sigma_a, sigma_s)"},
+      {"/lights/0/direction", json::array({0, 0, 0}), false,
+       "scene.json: /lights/0/direction: must have non-zero length"},
+      {"/lights/0/direction", json::array({0, 1}), false,
+       "scene.json: /lights/0/direction: must be an array of 3 numbers"},
       {"/lights/0/irradiance", -1.0, false, "scene.json: /lights/0/irradiance: must be >= 0"},
       {"/lights/1/type", "spot", false,
        "scene.json: /lights/1/type: unknown light 'spot' (known: directional, point, environment)"},
@@ -92,17 +99,21 @@ TEST(Scene, BadInputCatalogue) {
       {"/camera/width", 12.5, false, "scene.json: /camera/width: must be a whole number"},
       {"/camera/height", 20000, false, "scene.json: /camera/height: must be <= 16384"},
       {"/camera/fov_y_deg", 180, false, "scene.json: /camera/fov_y_deg: must be <= 179"},
-      {"/camera/look_at", json::array({0, -5, 0}), false, "scene.json: /camera/look_at: must differ from position"},
+      {"/camera/look_at", json::array({0, -5, 0}), false,
+       "scene.json: /camera/look_at: must differ from position"},
       {"/camera/up", json::array({0, 2, 0}), false,
        "scene.json: /camera/up: must not be parallel to the view direction (look_at - position)"},
       {"/camera", nullptr, true, "scene.json: /camera: required field is missing"},
       {"/integrator/spp", 0, false, "scene.json: /integrator/spp: must be >= 1"},
-      {"/integrator/type", "magic", false, "scene.json: /integrator/type: unknown integrator 'magic' (known: pathtrace, single, mfs, octave)"},
-      {"/integrator/tau_step", 0.1, false, "scene.json: /integrator/tau_step: unknown field (known here: max_wide_scatters, peak_fraction)"},
+      {"/integrator/type", "magic", false,
+       "scene.json: /integrator/type: unknown integrator 'magic' (known: pathtrace, single, mfs, octave)"},
+      {"/integrator/tau_step", 0.1, false,
+       "scene.json: /integrator/tau_step: unknown field (known here: max_wide_scatters, peak_fraction)"},
       {"/integrator/max_events", -1, false, "scene.json: /integrator/max_events: must be >= 0"},
       {"/media", json::object(), false, "scene.json: /media: must be an array, not an object"},
       {"/media/0", 3, false, "scene.json: /media/0: must be an object, not a number"},
-      {"/extra", 1, false, "scene.json: /extra: unknown field (known here: camera, integrator, lights, media)"},
+      {"/extra", 1, false,
+       "scene.json: /extra: unknown field (known here: camera, integrator, lights, media)"},
   };
   for (const Case& c : cases) {
     EXPECT_EQ(message_for(c.pointer, c.value, c.remove), c.expected) << c.pointer;
@@ -138,7 +149,8 @@ TEST(Scene, FileErrorsNameTheFile) {
     load_scene(dir / "overflow.json");
     FAIL();
   } catch (const Error& e) {
-    EXPECT_EQ(std::string(e.what()).rfind((dir / "overflow.json").string() + ": not valid JSON", 0), 0u) << e.what();
+    EXPECT_EQ(std::string(e.what()).rfind((dir / "overflow.json").string() + ": not valid JSON", 0), 0u)
+        << e.what();
   }
   try {
     load_scene(bad);

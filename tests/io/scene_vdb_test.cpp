@@ -17,7 +17,8 @@ const std::filesystem::path kShared = NIMBUS_SHARED_DIR;
 
 std::string cloud_scene(const std::string& file, const std::string& grid = "density") {
   return "{" + test::camera_json(8, 8, 35, 900) + R"(,
-    "media": [{"shape": {"type": "vdb", "file": ")" + file + R"(", "grid": ")" + grid + R"(", "scale": 1.0},
+    "media": [{"shape": {"type": "vdb", "file": ")" +
+         file + R"(", "grid": ")" + grid + R"(", "scale": 1.0},
                "sigma_s": 0.1, "sigma_a": 0.001, "phase": {"type": "hg", "g": 0.8}}],
     "lights": [{"type": "directional", "direction": [-0.5, 0.6, -0.62], "irradiance": 3.0},
                {"type": "environment", "radiance": [0.06, 0.1, 0.2]}]})";

@@ -24,7 +24,6 @@ void init() {
   (void)done;
 }
 
-
 void write_vdb(const std::filesystem::path& file, const openvdb::GridPtrVec& grids) {
   openvdb::io::File f(file.string());
   f.write(grids);

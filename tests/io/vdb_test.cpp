@@ -30,7 +30,6 @@ const DensityGrid& cached(const char* name) {
   return it->second;
 }
 
-
 TEST(VdbLoad, CloudMatchesSources) {
   NIMBUS_REQUIRE_FILE(shared_volume(kCloud));
   const DensityGrid& g = cached(kCloud);
@@ -222,7 +221,8 @@ TEST(VdbErrors, MissingEmptyDirectoryAndText) {
   EXPECT_NE(test::load_error(dir / "dir.vdb").find("directory"), std::string::npos);
   const std::string text = "# not a volume\nhello world\n";
   test::write_bytes(dir / "text.vdb", std::vector<char>(text.begin(), text.end()));
-  EXPECT_NE(test::load_error(dir / "text.vdb").find("text.vdb: not a VDB or NanoVDB file"), std::string::npos);
+  EXPECT_NE(test::load_error(dir / "text.vdb").find("text.vdb: not a VDB or NanoVDB file"),
+            std::string::npos);
   test::write_bytes(dir / "text.nvdb", std::vector<char>(text.begin(), text.end()));
   EXPECT_NE(test::load_error(dir / "text.nvdb").find("not a VDB or NanoVDB file"), std::string::npos);
   EXPECT_THROW(inspect_volume_file(dir / "text.vdb"), Error);

@@ -22,7 +22,6 @@ inline std::filesystem::path shared_volume(const char* name) {
 inline const char* kCloud = "wdas_cloud_sixteenth.vdb";
 inline const char* kSmoke = "openvdb_fvdb_smoke-blosc.nvdb";
 
-
 inline std::vector<char> read_bytes(const std::filesystem::path& file) {
   std::ifstream is(file, std::ios::binary);
   return {std::istreambuf_iterator<char>(is), std::istreambuf_iterator<char>()};

@@ -1,9 +1,10 @@
 // The procedural cloud: deterministic, bounded, and a real cloud (a substantial, connected body).
+#include "media/cloud.h"
+
 #include <gtest/gtest.h>
 
 #include "io/scene_volumes.h"
 #include "media/density_grid.h"
-#include "media/cloud.h"
 
 namespace nimbus {
 namespace {

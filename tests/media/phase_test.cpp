@@ -1,12 +1,13 @@
 // Phase functions: normalisation by independent quadrature, mean cosine, and chi-square tests of
 // every sampler against its own eval (sample pdf == eval pdf).
+#include "media/phase.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 
 #include "core/rng.h"
 #include "nimbus/error.h"
-#include "media/phase.h"
 #include "support/stats.h"
 
 namespace nimbus {
@@ -31,9 +32,16 @@ std::vector<Phase> all_phases() {
     th.push_back(kPi * i / 180.0);
     v.push_back(std::exp(-20.0 * th.back()) + 0.05 + 0.02 * std::cos(th.back()));
   }
-  return {IsotropicPhase{},          HgPhase{0.0},    HgPhase{0.3},   HgPhase{0.85},
-          HgPhase{-0.7},             HgPhase{0.99},   DoubleHgPhase{0.9, -0.3, 0.8},
-          make_gauss_phase(0.01),    make_gauss_phase(0.3), make_gauss_phase(3.0),
+  return {IsotropicPhase{},
+          HgPhase{0.0},
+          HgPhase{0.3},
+          HgPhase{0.85},
+          HgPhase{-0.7},
+          HgPhase{0.99},
+          DoubleHgPhase{0.9, -0.3, 0.8},
+          make_gauss_phase(0.01),
+          make_gauss_phase(0.3),
+          make_gauss_phase(3.0),
           make_tabulated_phase("test", th, v)};
 }
 

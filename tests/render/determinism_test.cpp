@@ -23,7 +23,8 @@ std::string scene_json(const std::string& integrator_block) {
     "lights": [{"type": "directional", "direction": [-0.5, 0.6, -0.6], "irradiance": 2.0, "angular_diameter_deg": 1},
                {"type": "point", "position": [0.5, -1.5, 1.2], "intensity": 2.0},
                {"type": "environment", "radiance": [0.1, 0.15, 0.3]}],
-    "integrator": )" + integrator_block + "}";
+    "integrator": )" +
+         integrator_block + "}";
 }
 
 RenderResult render_with(const Scene& scene, int threads) {
@@ -35,7 +36,8 @@ RenderResult render_with(const Scene& scene, int threads) {
 
 void expect_identical(const RenderResult& a, const RenderResult& b, const std::string& what) {
   ASSERT_EQ(a.image.rgb.size(), b.image.rgb.size()) << what;
-  EXPECT_EQ(0, std::memcmp(a.image.rgb.data(), b.image.rgb.data(), a.image.rgb.size() * sizeof(float))) << what;
+  EXPECT_EQ(0, std::memcmp(a.image.rgb.data(), b.image.rgb.data(), a.image.rgb.size() * sizeof(float)))
+      << what;
 }
 
 void check_deterministic(const std::string& name, const std::string& integrator_block) {
@@ -61,8 +63,9 @@ TEST(Determinism, EveryIntegratorIsBitIdenticalForAnyThreadCount) {
 }
 
 TEST(Determinism, ShadowMapsAndEventLimitsAreBitIdenticalToo) {
-  check_deterministic("single/shadow_map",
-                      R"({"type": "single", "spp": 2, "transmittance": "shadow_map", "shadow_map_resolution": 16})");
+  check_deterministic(
+      "single/shadow_map",
+      R"({"type": "single", "spp": 2, "transmittance": "shadow_map", "shadow_map_resolution": 16})");
   check_deterministic("single/light_samples", R"({"type": "single", "spp": 1, "light_samples": 3})");
   check_deterministic("pathtrace/max_events", R"({"type": "pathtrace", "spp": 2, "max_events": 2})");
 }

@@ -1,10 +1,11 @@
 // The film: pixel means from sums and counts, dropped non-finite samples, extra layers.
+#include "render/film.h"
+
 #include <gtest/gtest.h>
 
 #include <limits>
 
 #include "nimbus/error.h"
-#include "render/film.h"
 
 namespace nimbus {
 namespace {

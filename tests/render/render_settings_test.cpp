@@ -23,7 +23,8 @@ Scene sphere_scene(const std::string& integrator) {
                "phase": {"type": "hg", "g": 0.8}}],
     "lights": [{"type": "directional", "direction": [-1, 0.3, 0.2], "irradiance": 1.0},
                {"type": "environment", "radiance": 0.2}],
-    "integrator": )" + integrator + "}");
+    "integrator": )" + integrator +
+                               "}");
 }
 
 TEST(RenderSettings, AutoChoicesAreResolvedInTheHeader) {

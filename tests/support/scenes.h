@@ -1,9 +1,8 @@
 // Small scenes for tests, built from JSON text.
 #pragma once
 
-#include <string>
-
 #include <nlohmann/json.hpp>
+#include <string>
 
 #include "nimbus/scene.h"
 

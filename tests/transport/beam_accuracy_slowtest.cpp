@@ -4,12 +4,12 @@
 //  - the generalised propagator (gsa) for HG g = 0.9 and 0.95 at b z = 1, 3, 10 (albedo 0.9, where
 //    forward light dominates: docs/validation/beam.md) within 10% on both, and on the Gaussian peak.
 // On-axis radiance is the mean over a cone of 0.3 HWHM; tolerances add 3 Monte Carlo standard errors.
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <map>
 #include <string>
 #include <vector>
-
-#include <gtest/gtest.h>
 
 #include "core/math.h"
 #include "transport/beam_table.h"
@@ -49,7 +49,8 @@ Metrics metrics(const std::vector<BeamRow>& rows, const std::string& model, doub
       const double c0 = 0.5 * (lo[i - 1] + hi[i - 1]), c1 = 0.5 * (lo[i] + hi[i]);
       const double slope = (v[i] - v[i - 1]) / (c1 - c0);
       m.hwhm = c0 + (half - v[i - 1]) / slope;
-      const double ev = std::sqrt(0.25 * (e[i] * e[i] + e[i - 1] * e[i - 1]) + 0.25 * m.on_axis_err * m.on_axis_err);
+      const double ev =
+          std::sqrt(0.25 * (e[i] * e[i] + e[i - 1] * e[i - 1]) + 0.25 * m.on_axis_err * m.on_axis_err);
       m.hwhm_err = ev / std::abs(slope);
       return m;
     }
@@ -71,8 +72,8 @@ struct Check {
   double on_axis_tol, hwhm_tol;
 };
 
-void check_case(const Phase& phase, double albedo, const std::vector<double>& depths, const std::vector<Check>& checks,
-                double photons) {
+void check_case(const Phase& phase, double albedo, const std::vector<double>& depths,
+                const std::vector<Check>& checks, double photons) {
   for (double z : depths) {
     const double h = model_hwhm(phase, z, albedo), w = h / 10.0;
     BeamSettings s;
@@ -91,8 +92,10 @@ void check_case(const Phase& phase, double albedo, const std::vector<double>& de
     for (const Check& c : checks) {
       const Metrics m = metrics(rows, c.model, z, w);
       const double e_on = m.on_axis / mc.on_axis - 1.0, e_w = m.hwhm / mc.hwhm - 1.0;
-      ::testing::Test::RecordProperty(c.model + "_z" + std::to_string(int(z)) + "_on_axis_err", std::to_string(e_on));
-      ::testing::Test::RecordProperty(c.model + "_z" + std::to_string(int(z)) + "_hwhm_err", std::to_string(e_w));
+      ::testing::Test::RecordProperty(c.model + "_z" + std::to_string(int(z)) + "_on_axis_err",
+                                      std::to_string(e_on));
+      ::testing::Test::RecordProperty(c.model + "_z" + std::to_string(int(z)) + "_hwhm_err",
+                                      std::to_string(e_w));
       EXPECT_LT(std::abs(e_on), c.on_axis_tol + 3.0 * mc.on_axis_err / mc.on_axis)
           << phase_describe(phase) << " albedo " << albedo << " bz " << z << " model " << c.model;
       EXPECT_LT(std::abs(e_w), c.hwhm_tol + 3.0 * mc.hwhm_err / mc.hwhm)

@@ -2,9 +2,9 @@
 // Feynman-Kac random walk that checks the total and both marginals independently of the algebra.
 #include "transport/mfs_kernel.h"
 
-#include <cmath>
-
 #include <gtest/gtest.h>
+
+#include <cmath>
 
 #include "core/math.h"
 #include "core/rng.h"
@@ -17,7 +17,8 @@ namespace {
 struct Case {
   double z, b, a, theta2;
 };
-const Case kCases[] = {{1.0, 1.0, 0.0, 0.01}, {10.0, 1.0, 0.01, 0.01}, {30.0, 1.0, 0.1, 0.02}, {3.0, 2.0, 0.5, 0.005}};
+const Case kCases[] = {
+    {1.0, 1.0, 0.0, 0.01}, {10.0, 1.0, 0.01, 0.01}, {30.0, 1.0, 0.1, 0.02}, {3.0, 2.0, 0.5, 0.005}};
 
 // 4-D trapezoid over (r, v) of the fixed-axis kernel for a source along the axis.
 double integrate_fixed_axis(const MfsScales& s, const GaussianBeam& g) {
@@ -110,8 +111,8 @@ TEST(MfsKernel, SymmetryAndPaperFormMatchesFixedAxisWithoutAbsorption) {
   const double c = std::cos(0.7), sn = std::sin(0.7);
   auto rot = [&](const Vec2& v) { return Vec2(c * v.x - sn * v.y, sn * v.x + c * v.y); };
   EXPECT_NEAR(mfs_green(s, rot(g1), rot(g2)), mfs_green(s, g1, g2), 1e-12 * mfs_green(s, g1, g2));
-  EXPECT_NEAR(mfs_fixed_axis(s, rot(Vec2(0.1, 0.2)), rot(g1), rot(g2)), mfs_fixed_axis(s, Vec2(0.1, 0.2), g1, g2),
-              1e-12 * mfs_fixed_axis(s, Vec2(0.1, 0.2), g1, g2));
+  EXPECT_NEAR(mfs_fixed_axis(s, rot(Vec2(0.1, 0.2)), rot(g1), rot(g2)),
+              mfs_fixed_axis(s, Vec2(0.1, 0.2), g1, g2), 1e-12 * mfs_fixed_axis(s, Vec2(0.1, 0.2), g1, g2));
   // Without absorption the tilted-axis (paper) and fixed-axis actions agree exactly:
   // gamma = v - r/z, gamma' = v0 - r/z.
   const double z = 4.0;
@@ -125,27 +126,31 @@ TEST(MfsKernel, NumericallyStableEverywhere) {
   // h(x): series and closed form agree where they meet, and match long-double arithmetic.
   for (double x : {1e-8, 1e-3, 0.05, 0.0999, 0.1, 0.1001, 0.5, 3.0, 50.0}) {
     const long double lx = x;
-    const long double ref = x < 1e-2 ? lx * lx * lx / 12.0L - lx * lx * lx * lx * lx / 120.0L : lx - 2.0L * std::tanh(lx / 2.0L);
+    const long double ref =
+        x < 1e-2 ? lx * lx * lx / 12.0L - lx * lx * lx * lx * lx / 120.0L : lx - 2.0L * std::tanh(lx / 2.0L);
     EXPECT_NEAR(mfs_h(x) / double(ref), 1.0, 1e-12) << x;
   }
   EXPECT_NEAR(mfs_h_over_x3(0.0), 1.0 / 12.0, 1e-16);
   // Extremes: a -> 0, b z -> 0, b z huge, z / L huge.  All finite, non-negative, no NaN.
-  const double params[][4] = {{1.0, 1.0, 0.0, 0.01},   {1.0, 1e-12, 0.0, 0.01}, {1.0, 1e-12, 1e-12, 0.01},
-                              {1e3, 1e3, 0.0, 0.01},   {1e4, 1e4, 1e3, 0.01},   {1.0, 1e3, 1e3, 0.5},
+  const double params[][4] = {{1.0, 1.0, 0.0, 0.01},    {1.0, 1e-12, 0.0, 0.01}, {1.0, 1e-12, 1e-12, 0.01},
+                              {1e3, 1e3, 0.0, 0.01},    {1e4, 1e4, 1e3, 0.01},   {1.0, 1e3, 1e3, 0.5},
                               {1e-6, 1e-6, 1e-9, 1e-4}, {5.0, 5.0, 1e-300, 0.01}};
   for (const auto& p : params)
     for (GaussianModel m : {GaussianModel::Dolin, GaussianModel::Tes87, GaussianModel::Mfs}) {
       const MfsScales s = mfs_scales(m, p[0], p[1], p[2], p[3]);
       const GaussianBeam g = gaussian_beam(m, p[0], p[1], p[2], p[3]);
-      for (double v : {g.total, g.var_angle, g.var_radius, g.cov, mfs_green(s, Vec2(0.01, 0.0), Vec2(0.0, 0.0)),
-                       mfs_fixed_axis(s, Vec2(0.0, 0.0), Vec2(0.0, 0.0), Vec2(0.0, 0.0))}) {
+      for (double v :
+           {g.total, g.var_angle, g.var_radius, g.cov, mfs_green(s, Vec2(0.01, 0.0), Vec2(0.0, 0.0)),
+            mfs_fixed_axis(s, Vec2(0.0, 0.0), Vec2(0.0, 0.0), Vec2(0.0, 0.0))}) {
         EXPECT_TRUE(std::isfinite(v) && v >= 0.0) << p[0] << " " << p[1] << " " << p[2];
       }
     }
   // Continuous across the x = 1e-4 switch of the hyperbolic helpers.
   const double th2 = 0.01;
-  const GaussianBeam lo = gaussian_beam(GaussianModel::Mfs, 1.0, 1.0, 0.99998e-8 / (th2 / (1 - std::exp(-1.0))), th2);
-  const GaussianBeam hi = gaussian_beam(GaussianModel::Mfs, 1.0, 1.0, 1.00002e-8 / (th2 / (1 - std::exp(-1.0))), th2);
+  const GaussianBeam lo =
+      gaussian_beam(GaussianModel::Mfs, 1.0, 1.0, 0.99998e-8 / (th2 / (1 - std::exp(-1.0))), th2);
+  const GaussianBeam hi =
+      gaussian_beam(GaussianModel::Mfs, 1.0, 1.0, 1.00002e-8 / (th2 / (1 - std::exp(-1.0))), th2);
   EXPECT_NEAR(lo.var_radius / hi.var_radius, 1.0, 1e-9);
   EXPECT_THROW(mfs_scales(GaussianModel::Mfs, 0.0, 1.0, 0.0, 0.01), Error);
   EXPECT_THROW(mfs_scales(GaussianModel::Mfs, 1.0, -1.0, 0.0, 0.01), Error);

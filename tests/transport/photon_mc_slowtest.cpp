@@ -1,9 +1,9 @@
 // Slab Monte Carlo against independent solutions: Chandrasekhar's H-function for a semi-infinite
 // isotropic medium, and van de Hulst's tabulated slab (the MCML paper's first check).
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <vector>
-
-#include <gtest/gtest.h>
 
 #include "core/math.h"
 #include "transport/photon_mc.h"
@@ -56,7 +56,8 @@ double semi_infinite_isotropic_albedo(double omega) {
 TEST(PhotonMcSlow, SemiInfiniteIsotropicMatchesHFunction) {
   const double omega = 0.9;
   const double expected = semi_infinite_isotropic_albedo(omega);
-  EXPECT_NEAR(expected, 0.41495, 1e-4);  // H(1) = 1.8501 (the H integral identity checked in the notes of this test)
+  EXPECT_NEAR(expected, 0.41495,
+              1e-4);  // H(1) = 1.8501 (the H integral identity checked in the notes of this test)
   PhotonMcSettings s;
   s.sigma_s = omega;
   s.sigma_a = 1.0 - omega;
@@ -101,7 +102,8 @@ TEST(PhotonMcSlow, SemiInfiniteMismatchedBoundaryGiovanelli) {
   const PhotonMcResult r = run_photon_mc(s);
   EXPECT_NEAR(r.specular.value, 0.04, 1e-12);
   EXPECT_NEAR(r.specular.value + r.diffuse_reflectance.value, 0.2600, 5.0 * r.diffuse_reflectance.err + 5e-4);
-  EXPECT_NEAR(r.specular.value + r.diffuse_reflectance.value + r.transmittance.value + r.absorbed.value, 1.0, 1e-4);
+  EXPECT_NEAR(r.specular.value + r.diffuse_reflectance.value + r.transmittance.value + r.absorbed.value, 1.0,
+              1e-4);
 }
 
 }  // namespace

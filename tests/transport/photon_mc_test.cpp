@@ -2,10 +2,10 @@
 // determinism across thread counts.  Short runs; tolerances from the estimated standard errors.
 #include "transport/photon_mc.h"
 
-#include <cmath>
-
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
+
+#include <cmath>
 
 #include "core/math.h"
 #include "nimbus/error.h"
@@ -63,7 +63,8 @@ TEST(PhotonMc, SlabEnergyBalanceCloses) {
     s.photons = 4000;
     s.batches = 10;
     const PhotonMcResult r = run_photon_mc(s);
-    const double sum = r.specular.value + r.diffuse_reflectance.value + r.transmittance.value + r.absorbed.value;
+    const double sum =
+        r.specular.value + r.diffuse_reflectance.value + r.transmittance.value + r.absorbed.value;
     // Weight splitting at the faces is exact; only roulette (weights ~1e-4) perturbs the balance.
     EXPECT_NEAR(sum, 1.0, 2e-4) << "n=" << n;
     EXPECT_NEAR(r.specular.value, std::pow((n - 1) / (n + 1), 2), 1e-15);
@@ -85,7 +86,8 @@ TEST(PhotonMc, AbsorbingSlabWithFresnelFacesIsExact) {
   const double R = 1.0 / 9.0, e = std::exp(-0.5), den = 1.0 - R * R * e * e;
   EXPECT_NEAR(r.transmittance.value, (1 - R) * (1 - R) * e / den, 5.0 * r.transmittance.err);
   EXPECT_NEAR(r.unscattered_transmittance.value, r.transmittance.value, 1e-15);
-  EXPECT_NEAR(r.diffuse_reflectance.value, (1 - R) * (1 - R) * R * e * e / den, 5.0 * r.diffuse_reflectance.err + 1e-4);
+  EXPECT_NEAR(r.diffuse_reflectance.value, (1 - R) * (1 - R) * R * e * e / den,
+              5.0 * r.diffuse_reflectance.err + 1e-4);
 }
 
 TEST(PhotonMc, DeterministicForASeedWhateverTheThreadCount) {
@@ -110,7 +112,8 @@ TEST(PhotonMc, DeterministicForASeedWhateverTheThreadCount) {
       EXPECT_EQ(a.planes[k].angular[i].value, b.planes[k].angular[i].value);
       EXPECT_EQ(a.planes[k].angular[i].err, b.planes[k].angular[i].err);
     }
-    for (size_t i = 0; i < a.planes[k].radial.size(); ++i) EXPECT_EQ(a.planes[k].radial[i].value, b.planes[k].radial[i].value);
+    for (size_t i = 0; i < a.planes[k].radial.size(); ++i)
+      EXPECT_EQ(a.planes[k].radial[i].value, b.planes[k].radial[i].value);
   }
   s.seed = 43;
   const PhotonMcResult c = run_photon_mc(s);

@@ -2,9 +2,9 @@
 // angular and radial profiles, and the spatial second moment against the random-walk value.
 #include "transport/small_angle.h"
 
-#include <cmath>
-
 #include <gtest/gtest.h>
+
+#include <cmath>
 
 #include "core/math.h"
 #include "nimbus/error.h"
@@ -55,7 +55,8 @@ TEST(SmallAngle, HgAngularProfileIsTheHgPoissonSeries) {
 }
 
 TEST(SmallAngle, ProfilesAreNormalised) {
-  for (const Phase& ph : {Phase{HgPhase{0.95}}, Phase{make_gauss_phase(0.01)}, Phase{DoubleHgPhase{0.9, -0.2, 0.9}}}) {
+  for (const Phase& ph :
+       {Phase{HgPhase{0.95}}, Phase{make_gauss_phase(0.01)}, Phase{DoubleHgPhase{0.9, -0.2, 0.9}}}) {
     const ForwardPropagator prop(ph);
     for (double tau_s : {0.1, 1.0, 10.0}) {
       const ForwardProfile p = prop.profile(tau_s, 0.05 * tau_s);
@@ -72,14 +73,17 @@ TEST(SmallAngle, ProfilesAreNormalised) {
       }
       EXPECT_NEAR(sum, total, 1e-4 * total);
       EXPECT_NEAR(flux, p.forward_flux(), 1e-4 * total);
-      EXPECT_NEAR(p.angular_within(0.3), [&] {
-        double s = 0.0;
-        for (int i = 0; i < n; ++i) {
-          const double t = 0.3 * (i + 0.5) / n;
-          s += p.angular(t) * 2.0 * kPi * std::sin(t) * 0.3 / n;
-        }
-        return s;
-      }(), 1e-4 * total);
+      EXPECT_NEAR(
+          p.angular_within(0.3),
+          [&] {
+            double s = 0.0;
+            for (int i = 0; i < n; ++i) {
+              const double t = 0.3 * (i + 0.5) / n;
+              s += p.angular(t) * 2.0 * kPi * std::sin(t) * 0.3 / n;
+            }
+            return s;
+          }(),
+          1e-4 * total);
       // The radial profile carries all scattered light.
       const double far = p.radial_within(1e4 * tau_s);
       EXPECT_NEAR(far, total, 2e-3 * total) << tau_s;
