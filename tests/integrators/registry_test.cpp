@@ -4,6 +4,12 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <iterator>
+#include <set>
+
 #include "integrators/mfs.h"
 #include "integrators/octave.h"
 #include "integrators/pathtrace.h"
@@ -98,6 +104,50 @@ TEST(Registry, UnknownFieldsAndNamesAreErrors) {
     EXPECT_FALSE(e.summary.empty()) << e.name;
   }
   EXPECT_EQ(names, integrator_names());
+}
+
+}  // namespace
+}  // namespace nimbus
+
+namespace nimbus {
+namespace {
+
+// The fields of the options table at the top of src/integrators/NAME.h ("// | `field` | ...").
+std::set<std::string> table_fields(const std::string& name) {
+  std::ifstream in(std::filesystem::path(NIMBUS_SOURCE_DIR) / "src" / "integrators" / (name + ".h"));
+  std::set<std::string> fields;
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.rfind("// | `", 0) != 0) continue;
+    const size_t a = line.find('`') + 1, b = line.find('`', a);
+    fields.insert(line.substr(a, b - a));
+  }
+  return fields;
+}
+
+std::set<std::string> keys(const nlohmann::json& j) {
+  std::set<std::string> k;
+  for (const auto& [key, value] : j.items()) k.insert(key);
+  return k;
+}
+
+// The tables that open the integrators' headers list exactly the JSON keys their settings read and
+// write, and docs/scene-format.md names every one of them.
+TEST(Registry, OptionTablesMatchTheJsonKeys) {
+  PathTraceSettings pt;
+  pt.max_wide_scatters = 1;
+  const std::vector<std::pair<std::string, nlohmann::json>> cases = {{"pathtrace", to_json(pt)},
+                                                                     {"single", to_json(SingleSettings{})},
+                                                                     {"mfs", to_json(MfsSettings{})},
+                                                                     {"octave", to_json(OctaveSettings{})}};
+  std::ifstream doc(std::filesystem::path(NIMBUS_SOURCE_DIR) / "docs" / "scene-format.md");
+  const std::string text((std::istreambuf_iterator<char>(doc)), std::istreambuf_iterator<char>());
+  ASSERT_FALSE(text.empty());
+  for (const auto& [name, json] : cases) {
+    EXPECT_EQ(table_fields(name), keys(json)) << name;
+    for (const std::string& k : keys(json))
+      EXPECT_NE(text.find("`" + k + "`"), std::string::npos) << name << " " << k;
+  }
 }
 
 }  // namespace
