@@ -103,7 +103,6 @@ class MfsIntegrator final : public Integrator {
   Rgb Li(const Ray& ray, Rng& rng) const override;
   // The settings with "auto" resolved (scatter_grid_resolution).
   nlohmann::json settings_json() const override { return to_json(s_); }
-  const MfsSettings& settings() const { return s_; }
   const PhaseSplit& split(int medium) const { return *splits_[medium]; }
   const ScatterGrid* scatter_grid() const { return grid_.get(); }
   const BeamGrid* beam_grid() const { return beam_.get(); }

@@ -21,8 +21,6 @@ class Film {
   // Adds a layer of `channels` values per pixel; returns its index.
   int add_layer(const std::string& name, int channels);
   int layer_index(const std::string& name) const;  // -1 when absent
-  const std::string& layer_name(int layer) const { return layers_[size_t(layer)].name; }
-  int layer_count() const { return int(layers_.size()); }
 
   // One camera sample of pixel (x, y): its radiance added to the "rgb" layer when finite (a non-finite
   // sample is dropped and counted: returns false), and the pixel's sample count raised by one.

@@ -21,7 +21,6 @@ class PinholeCamera {
     width_ = c.width;
     height_ = c.height;
   }
-  const Vec3& origin() const { return origin_; }
   // Unit direction through image position (px, py) in pixels (px right, py down from the top).
   Vec3 direction(double px, double py) const {
     const double sx = (2.0 * px / width_ - 1.0) * tan_half_ * aspect_;
