@@ -4,6 +4,7 @@
 // (integrators/registry.h) parses each integrator's settings and constructs it.
 #pragma once
 
+#include <limits>
 #include <nlohmann/json.hpp>
 
 #include "core/math.h"
@@ -13,11 +14,38 @@
 
 namespace nimbus {
 
+// What one camera sample tells the film beyond its radiance: the compositing layers. Every field is a
+// one-sample estimate whose pixel mean is the layer (an integrator may fill it with an unbiased
+// stochastic estimate, e.g. an escape indicator for a transmittance). Radiances are parts of Li's
+// return value, never additions to it.
+struct CameraSample {
+  // The environment seen directly along the camera ray: T_escape * environment radiance. A transparent
+  // film subtracts it from the beauty.
+  Rgb background{0.0};
+  // Transmittance of the camera ray to the background (0 where it ends on a surface or a holdout).
+  Rgb escape_transmittance{1.0};
+  // Transmittance of the camera ray to a holdout it ends on (0 otherwise): the part of the pixel the
+  // holdout cuts out. Alpha = 1 - mean(escape_transmittance) - mean(holdout_transmittance) on a
+  // transparent film (or one without an environment); 1 - mean(holdout_transmittance) otherwise.
+  Rgb holdout_transmittance{0.0};
+  // Distance along the camera ray to the first surface or, in a volume, to where the ray's
+  // transmittance (mean over channels) falls to one half; infinity where neither.
+  double depth = std::numeric_limits<double>::infinity();
+  // Unscattered and single-scattered light (the camera ray's first interaction lit directly); the
+  // `indirect` layer is Li minus this.
+  Rgb direct{0.0};
+  // For denoisers: the first surface's albedo, or in a volume the single-scattering albedo where the
+  // depth is taken, and the shading normal of the first surface (0 in a volume).
+  Rgb albedo{0.0};
+  Vec3 normal{0.0, 0.0, 0.0};
+};
+
 class Integrator {
  public:
   virtual ~Integrator() = default;
-  // Radiance arriving at ray.o from direction -ray.d (light travelling against the ray).
-  virtual Rgb Li(const Ray& ray, Rng& rng) const = 0;
+  // Radiance arriving at ray.o from direction -ray.d (light travelling against the ray). With a
+  // non-null `sample` (camera rays of a film with layers), also fills the compositing layers.
+  virtual Rgb Li(const Ray& ray, Rng& rng, CameraSample* sample = nullptr) const = 0;
   // The integrator's own settings as the JSON fields of its integrator block, with "auto" choices
   // resolved: written into the image header, so that an image says exactly how it was made.
   virtual nlohmann::json settings_json() const = 0;

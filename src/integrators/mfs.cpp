@@ -136,7 +136,7 @@ size_t MfsIntegrator::memory_bytes() const {
 // The radiance along the camera ray as the sum of the estimators in mfs_estimators.h over a march fixed
 // in optical depth (docs/derivations.md: eq. D7 for the first wide scatter and the forward peak, D11 for
 // forward_side "light", D12 for the higher orders, D13 for the growing steps).
-Rgb MfsIntegrator::Li(const Ray& ray, Rng& rng) const {
+Rgb MfsIntegrator::Li(const Ray& ray, Rng& rng, CameraSample* sample) const {
   const Vec3 &o = ray.o, &d = ray.d;
   Rgb L(0.0);
   CameraPath cam;  // from the camera to the current step: T_full, T_red, tau_p, theta_p, tau_red, m0..m2

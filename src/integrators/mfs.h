@@ -100,7 +100,7 @@ class MfsIntegrator final : public Integrator {
  public:
   // seed: the scene's, for the photon grids.
   MfsIntegrator(const SceneContext& context, MfsSettings settings, uint64_t seed = 1);
-  Rgb Li(const Ray& ray, Rng& rng) const override;
+  Rgb Li(const Ray& ray, Rng& rng, CameraSample* sample = nullptr) const override;
   // The settings with "auto" resolved (scatter_grid_resolution).
   nlohmann::json settings_json() const override { return to_json(s_); }
   const PhaseSplit& split(int medium) const { return *splits_[medium]; }

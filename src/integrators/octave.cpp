@@ -88,7 +88,7 @@ Rgb OctaveIntegrator::octave_scatter(int j, double bj, const Vec3& p, const Vec3
   return in_scatter;
 }
 
-Rgb OctaveIntegrator::Li(const Ray& ray, Rng& rng) const {
+Rgb OctaveIntegrator::Li(const Ray& ray, Rng& rng, CameraSample* sample) const {
   const Vec3 &o = ray.o, &d = ray.d;
   const int N = s_.octaves;
   std::vector<double> aj(N), bj(N);

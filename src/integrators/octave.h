@@ -46,7 +46,7 @@ Phase scale_phase_eccentricity(const Phase& phase, double scale);
 class OctaveIntegrator final : public Integrator {
  public:
   OctaveIntegrator(const SceneContext& context, OctaveSettings settings);
-  Rgb Li(const Ray& ray, Rng& rng) const override;
+  Rgb Li(const Ray& ray, Rng& rng, CameraSample* sample = nullptr) const override;
   nlohmann::json settings_json() const override { return to_json(s_); }
 
  private:

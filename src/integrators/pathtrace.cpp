@@ -100,7 +100,7 @@ bool PathTracer::collide(const MediumPoint& mp, double maj, Rgb& beta, Rng& rng,
   return true;
 }
 
-Rgb PathTracer::Li(const Ray& ray, Rng& rng) const {
+Rgb PathTracer::Li(const Ray& ray, Rng& rng, CameraSample* sample) const {
   Rgb L(0.0), beta(1.0);
   Vec3 o = ray.o, d = ray.d;
   int wide = 0;  // wide scatters so far (with a wide-scatter limit)

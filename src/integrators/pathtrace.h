@@ -42,7 +42,7 @@ nlohmann::json to_json(const PathTraceSettings& s);
 class PathTracer final : public Integrator {
  public:
   PathTracer(const SceneContext& context, int max_events, PathTraceSettings settings = {});
-  Rgb Li(const Ray& ray, Rng& rng) const override;
+  Rgb Li(const Ray& ray, Rng& rng, CameraSample* sample = nullptr) const override;
   nlohmann::json settings_json() const override { return to_json(s_); }
 
  private:

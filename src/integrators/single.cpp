@@ -42,7 +42,7 @@ Rgb SingleScatter::light_transmittance(size_t l, const Vec3& p, const LightSampl
   return ratio_tracking_transmittance(ctx_.media, ctx_.majorants, p, ls.wi, ls.distance, rng);
 }
 
-Rgb SingleScatter::Li(const Ray& ray, Rng& rng) const {
+Rgb SingleScatter::Li(const Ray& ray, Rng& rng, CameraSample* sample) const {
   const Vec3 &o = ray.o, &d = ray.d;
   Rgb L(0.0), T(1.0);
   const double jitter = rng.uniform();

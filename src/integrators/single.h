@@ -37,7 +37,7 @@ nlohmann::json to_json(const SingleSettings& s);
 class SingleScatter final : public Integrator {
  public:
   SingleScatter(const SceneContext& context, SingleSettings settings);
-  Rgb Li(const Ray& ray, Rng& rng) const override;
+  Rgb Li(const Ray& ray, Rng& rng, CameraSample* sample = nullptr) const override;
   nlohmann::json settings_json() const override { return to_json(s_); }
 
  private:
