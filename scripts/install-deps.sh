@@ -10,6 +10,7 @@ packages=(
   libopenexr-dev libimath-dev libpng-dev
   libboost-iostreams-dev libtbb-dev nlohmann-json3-dev libcli11-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev
+  libembree-dev libtinyobjloader-dev
   clang-14 libclang-rt-14-dev
   python3 python3-numpy python3-matplotlib
 )
