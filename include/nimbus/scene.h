@@ -1,4 +1,4 @@
-// The scene: camera, media, lights and integrator settings, as read from a scene JSON file.
+// The scene: camera, media, surfaces, lights and integrator settings, as read from a scene JSON file.
 // docs/scene-format.md documents every field; src/io/scene_json.cpp parses and validates it.
 #pragma once
 
@@ -16,6 +16,7 @@
 namespace nimbus {
 
 class DensityGrid;
+class TriangleMesh;
 
 // Pinhole camera. fov_y_deg is the full vertical field of view; image row 0 is the top;
 // camera right = forward x up.
@@ -77,6 +78,40 @@ struct EnvironmentLight {
 };
 using Light = std::variant<DirectionalLight, PointLight, EnvironmentLight>;
 
+// Opaque surfaces (two-sided). Shapes: an analytic sphere, a rectangle (a quad of `size` across the
+// `up` direction's perpendicular and along `up`, facing `normal`), a box and a triangle mesh from a file.
+struct SphereSurface {
+  Vec3 center{0, 0, 0};
+  double radius = 1.0;
+};
+struct RectangleSurface {
+  Vec3 center{0, 0, 0};
+  Vec3 normal{0, 0, 1};
+  Vec3 up{0, 1, 0};
+  double width = 1.0, height = 1.0;  // `size`: along normal x up, and along up
+};
+struct BoxSurface {
+  Vec3 min{-1, -1, -1}, max{1, 1, 1};
+};
+struct MeshSurface {
+  std::string file;                          // as written in the scene
+  std::shared_ptr<const TriangleMesh> data;  // loaded by load_scene
+};
+using SurfaceShape = std::variant<SphereSurface, RectangleSurface, BoxSurface, MeshSurface>;
+
+// Lambertian reflection of `albedo`; a holdout occludes like any surface but is the compositor's matte:
+// zero radiance and zero alpha where the camera sees it.
+struct DiffuseMaterial {
+  Rgb albedo{0.8, 0.8, 0.8};
+};
+struct HoldoutMaterial {};
+using Material = std::variant<DiffuseMaterial, HoldoutMaterial>;
+
+struct Surface {
+  SurfaceShape shape;
+  Material material = DiffuseMaterial{};
+};
+
 struct IntegratorSettings {
   std::string type = "pathtrace";
   int spp = 64;
@@ -90,6 +125,7 @@ struct IntegratorSettings {
 struct Scene {
   Camera camera;
   std::vector<Medium> media;
+  std::vector<Surface> surfaces;
   std::vector<Light> lights;
   IntegratorSettings integrator;
   std::filesystem::path file;  // where it was read from (empty for built-in scenes)

@@ -20,6 +20,9 @@ inline double length(const Vec3& a) { return a.length(); }
 inline Vec3 normalize(const Vec3& a) { return a / a.length(); }
 
 inline double max_component(const Rgb& c) { return std::max({c.x, c.y, c.z}); }
+inline double max_abs_component(const Vec3& v) {
+  return std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)});
+}
 inline double min_component(const Rgb& c) { return std::min({c.x, c.y, c.z}); }
 inline double average(const Rgb& c) { return (c.x + c.y + c.z) / 3.0; }
 inline double luminance(const Rgb& c) { return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z; }
@@ -44,6 +47,11 @@ struct Frame {
 inline Vec3 spherical_direction(double cos_theta, double phi, const Vec3& n) {
   const double sin_theta = std::sqrt(std::max(0.0, 1.0 - cos_theta * cos_theta));
   return Frame(n).to_world({sin_theta * std::cos(phi), sin_theta * std::sin(phi), cos_theta});
+}
+
+// Cosine-weighted direction on the hemisphere around n (pdf cos(theta) / pi; Malley's method).
+inline Vec3 cosine_direction(const Vec3& n, double u1, double u2) {
+  return spherical_direction(std::sqrt(std::max(0.0, 1.0 - u1)), 2.0 * kPi * u2, n);
 }
 
 // Axis-aligned box.

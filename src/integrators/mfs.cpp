@@ -4,6 +4,7 @@
 
 #include "core/json_reader.h"
 #include "integrators/mfs_estimators.h"
+#include "integrators/surface_light.h"
 #include "integrators/tracking.h"
 #include "nimbus/error.h"
 
@@ -137,13 +138,19 @@ size_t MfsIntegrator::memory_bytes() const {
 // in optical depth (docs/derivations.md: eq. D7 for the first wide scatter and the forward peak, D11 for
 // forward_side "light", D12 for the higher orders, D13 for the growing steps).
 Rgb MfsIntegrator::Li(const Ray& ray, Rng& rng, CameraSample* sample) const {
+  return trace(ray, rng, sample, 1);
+}
+
+Rgb MfsIntegrator::trace(const Ray& ray, Rng& rng, CameraSample* sample, int bounces) const {
   const Vec3 &o = ray.o, &d = ray.d;
+  SurfaceHit hit;
+  const bool on_surface = ctx_.surfaces.intersect(o, d, std::numeric_limits<double>::infinity(), &hit);
   Rgb L(0.0);
   CameraPath cam;  // from the camera to the current step: T_full, T_red, tau_p, theta_p, tau_red, m0..m2
   const double jitter = rng.uniform();
   MediumPoint mp;
   march_growing(
-      ctx_.majorants, o, d, std::numeric_limits<double>::infinity(), s_.tau_step, jitter,
+      ctx_.majorants, o, d, hit.t, s_.tau_step, jitter,
       // Steps grow with the camera-side reduced depth: tau_step (1 + step_growth tau_red) (eq. D13).
       [&] { return 1.0 + s_.step_growth * max_component(cam.tau_red); },
       [&](const Vec3& p, double t, double dt) {
@@ -166,10 +173,12 @@ Rgb MfsIntegrator::Li(const Ray& ray, Rng& rng, CameraSample* sample) const {
         cam.advance(k, t, dt, jitter);
         return max_component(s_.light_side() ? cam.T_full : cam.T_red) > 1e-6;
       });
-  // Add the environment behind the medium; its scattered light is in the grid. Camera side: its
-  // peak-scattered light stays on the ray (smooth in angle), so only the reduced extinction removes it.
-  if (ctx_.has_environment) L += (s_.light_side() ? cam.T_full : cam.T_red) * ctx_.environment;
-  return L;
+  // Add the surface the ray ends on (lit directly and by one gathered ray) or the environment behind the
+  // medium (its scattered light is in the grid). Camera side: light smooth in angle keeps its
+  // peak-scattered part on the ray, so only the reduced extinction removes it.
+  const GatherFn gather = [&](const Ray& r) { return trace(r, rng, nullptr, bounces - 1); };
+  return L + ray_end_radiance(ctx_, on_surface ? &hit : nullptr, s_.light_side() ? cam.T_full : cam.T_red,
+                              rng, sample, bounces > 0 ? &gather : nullptr);
 }
 
 MfsIntegrator::MediumRadiance MfsIntegrator::medium_radiance(int i, const Vec3& p, const Vec3& d, double t,
@@ -183,6 +192,7 @@ MfsIntegrator::MediumRadiance MfsIntegrator::medium_radiance(int i, const Vec3& 
     LightSample ls;
     const double u1 = rng.uniform(), u2 = rng.uniform();
     if (!sample_light(ctx_.lights[l], p, u1, u2, &ls)) continue;
+    if (ctx_.surfaces.occluded(p, ls.wi, ls.distance)) continue;  // a surface shadows y
     const double mu = dot(d, ls.wi);
     const LightBeam beam = light_beam(l, i, p);
     if (s_.light_side()) {

@@ -101,6 +101,8 @@ class MfsIntegrator final : public Integrator {
   // seed: the scene's, for the photon grids.
   MfsIntegrator(const SceneContext& context, MfsSettings settings, uint64_t seed = 1);
   Rgb Li(const Ray& ray, Rng& rng, CameraSample* sample = nullptr) const override;
+  // Li with `bounces` more rays gathered at the surface the ray ends on (Li: 1).
+  Rgb trace(const Ray& ray, Rng& rng, CameraSample* sample, int bounces) const;
   // The settings with "auto" resolved (scatter_grid_resolution).
   nlohmann::json settings_json() const override { return to_json(s_); }
   const PhaseSplit& split(int medium) const { return *splits_[medium]; }

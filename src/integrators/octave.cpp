@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "core/json_reader.h"
+#include "integrators/surface_light.h"
 #include "integrators/tracking.h"
 #include "media/phase.h"
 #include "scene/lights.h"
@@ -77,8 +78,11 @@ Rgb OctaveIntegrator::octave_scatter(int j, double bj, const Vec3& p, const Vec3
     if (ctx_.has_environment) {
       const double u1 = rng.uniform(), u2 = rng.uniform();
       const Vec3 wi = phase_sample(phase, d, u1, u2);
-      const Rgb T = marched_transmittance(ctx_.media, ctx_.majorants, p, wi,
-                                          std::numeric_limits<double>::infinity(), 0.25 / std::max(bj, 0.05));
+      const Rgb T =
+          ctx_.surfaces.occluded(p, wi, std::numeric_limits<double>::infinity())
+              ? Rgb(0.0)
+              : marched_transmittance(ctx_.media, ctx_.majorants, p, wi,
+                                      std::numeric_limits<double>::infinity(), 0.25 / std::max(bj, 0.05));
       Rgb Tb;
       for (int c = 0; c < 3; ++c) Tb[c] = std::pow(std::max(T[c], 1e-300), bj);
       Li += ctx_.environment * Tb;
@@ -89,7 +93,13 @@ Rgb OctaveIntegrator::octave_scatter(int j, double bj, const Vec3& p, const Vec3
 }
 
 Rgb OctaveIntegrator::Li(const Ray& ray, Rng& rng, CameraSample* sample) const {
+  return trace(ray, rng, sample, 1);
+}
+
+Rgb OctaveIntegrator::trace(const Ray& ray, Rng& rng, CameraSample* sample, int bounces) const {
   const Vec3 &o = ray.o, &d = ray.d;
+  SurfaceHit hit;
+  const bool on_surface = ctx_.surfaces.intersect(o, d, std::numeric_limits<double>::infinity(), &hit);
   const int N = s_.octaves;
   std::vector<double> aj(N), bj(N);
   for (int j = 0; j < N; ++j) {
@@ -104,30 +114,33 @@ Rgb OctaveIntegrator::Li(const Ray& ray, Rng& rng, CameraSample* sample) const {
   lights.ls.resize(ctx_.lights.size());
   lights.T.resize(ctx_.lights.size());
   lights.ok.resize(ctx_.lights.size());
-  march(ctx_.majorants, o, d, std::numeric_limits<double>::infinity(), s_.tau_step, jitter,
-        [&](const Vec3& p, double, double dt) {
-          ctx_.media.eval(p, &mp);
-          if (max_component(mp.sigma_s) > 0.0) {
-            const Rgb tau_here = tau + mp.sigma_t() * (jitter * dt);
-            // Light transmittance exp(-tau_l) once per light (octave j: raised to b^j).
-            for (size_t l = 0; l < ctx_.lights.size(); ++l) {
-              const double u1 = rng.uniform(), u2 = rng.uniform();
-              lights.ok[l] = sample_light(ctx_.lights[l], p, u1, u2, &lights.ls[l]);
-              if (lights.ok[l]) lights.T[l] = maps_[l].lookup(p);
-            }
-            // Octave j: scattering a^j sigma_s seen through the camera-side transmittance exp(-b^j tau).
-            for (int j = 0; j < N; ++j) {
-              Rgb Tc;
-              for (int c = 0; c < 3; ++c) Tc[c] = std::exp(-bj[j] * tau_here[c]);
-              if (max_component(Tc) < 1e-7) continue;
-              L += Tc * octave_scatter(j, bj[j], p, d, mp, lights, rng) * (aj[j] * dt);
-            }
-          }
-          tau += mp.sigma_t() * dt;
-          return min_component(tau) * bj[N - 1] < 14.0;
-        });
-  if (ctx_.has_environment) L += exp(-tau) * ctx_.environment;
-  return L;
+  march(ctx_.majorants, o, d, hit.t, s_.tau_step, jitter, [&](const Vec3& p, double, double dt) {
+    ctx_.media.eval(p, &mp);
+    if (max_component(mp.sigma_s) > 0.0) {
+      const Rgb tau_here = tau + mp.sigma_t() * (jitter * dt);
+      // Light transmittance exp(-tau_l) once per light (octave j: raised to b^j).
+      for (size_t l = 0; l < ctx_.lights.size(); ++l) {
+        const double u1 = rng.uniform(), u2 = rng.uniform();
+        lights.ok[l] = sample_light(ctx_.lights[l], p, u1, u2, &lights.ls[l]);
+        if (lights.ok[l] && ctx_.surfaces.occluded(p, lights.ls[l].wi, lights.ls[l].distance))
+          lights.ok[l] = false;
+        if (lights.ok[l]) lights.T[l] = maps_[l].lookup(p);
+      }
+      // Octave j: scattering a^j sigma_s seen through the camera-side transmittance exp(-b^j tau).
+      for (int j = 0; j < N; ++j) {
+        Rgb Tc;
+        for (int c = 0; c < 3; ++c) Tc[c] = std::exp(-bj[j] * tau_here[c]);
+        if (max_component(Tc) < 1e-7) continue;
+        L += Tc * octave_scatter(j, bj[j], p, d, mp, lights, rng) * (aj[j] * dt);
+      }
+    }
+    tau += mp.sigma_t() * dt;
+    return min_component(tau) * bj[N - 1] < 14.0;
+  });
+  // The surface the ray ends on (lit directly and by one gathered ray) or the environment.
+  const GatherFn gather = [&](const Ray& r) { return trace(r, rng, nullptr, bounces - 1); };
+  return L + ray_end_radiance(ctx_, on_surface ? &hit : nullptr, exp(-tau), rng, sample,
+                              bounces > 0 ? &gather : nullptr);
 }
 
 }  // namespace nimbus

@@ -47,6 +47,8 @@ class OctaveIntegrator final : public Integrator {
  public:
   OctaveIntegrator(const SceneContext& context, OctaveSettings settings);
   Rgb Li(const Ray& ray, Rng& rng, CameraSample* sample = nullptr) const override;
+  // Li with `bounces` more rays gathered at the surface the ray ends on (Li: 1).
+  Rgb trace(const Ray& ray, Rng& rng, CameraSample* sample, int bounces) const;
   nlohmann::json settings_json() const override { return to_json(s_); }
 
  private:

@@ -1,6 +1,7 @@
 #include "integrators/pathtrace.h"
 
 #include "core/json_reader.h"
+#include "integrators/surface_light.h"
 #include "integrators/tracking.h"
 #include "scene/lights.h"
 
@@ -55,15 +56,13 @@ Rgb PathTracer::direct_light(const Vec3& p, const Vec3& d, int medium, int wide_
     if (!sample_light(light, p, u1, u2, &ls)) continue;
     const double f = phase_eval(phase, dot(d, ls.wi)) * split_weight(medium, dot(d, ls.wi), wide_scatters);
     if (f <= 0.0) continue;
-    const Rgb T = ratio_tracking_transmittance(ctx_.media, ctx_.majorants, p, ls.wi, ls.distance, rng);
-    L += ls.weight * T * f;
+    L += ls.weight * shadow_transmittance(ctx_, p, ls.wi, ls.distance, rng) * f;
   }
   // The environment through a phase-sampled direction: f / pdf = 1.
   if (ctx_.has_environment) {
     const double u1 = rng.uniform(), u2 = rng.uniform();
     const Vec3 wi = phase_sample(phase, d, u1, u2);
-    const Rgb T = ratio_tracking_transmittance(ctx_.media, ctx_.majorants, p, wi,
-                                               std::numeric_limits<double>::infinity(), rng);
+    const Rgb T = shadow_transmittance(ctx_, p, wi, std::numeric_limits<double>::infinity(), rng);
     L += ctx_.environment * T * split_weight(medium, dot(d, wi), wide_scatters);
   }
   return L;
@@ -106,39 +105,37 @@ Rgb PathTracer::Li(const Ray& ray, Rng& rng, CameraSample* sample) const {
   int wide = 0;  // wide scatters so far (with a wide-scatter limit)
   MediumPoint mp;
   for (int events = 0;; ++events) {
+    // The free flight ends at the first surface, if any.
+    SurfaceHit hit;
+    const bool to_surface = ctx_.surfaces.intersect(o, d, std::numeric_limits<double>::infinity(), &hit);
     // Delta tracking to the next real scattering event.
     int scatter_medium = -1;
     Vec3 scatter_p;
-    const bool escaped = track(ctx_.majorants, o, d, std::numeric_limits<double>::infinity(), rng,
-                               [&](const Vec3& p, double maj) {
-                                 ctx_.media.eval(p, &mp);
-                                 if (!collide(mp, maj, beta, rng, &scatter_medium)) return true;
-                                 scatter_p = p;
-                                 return false;
-                               });
-    if (escaped) {
+    const bool escaped = track(ctx_.majorants, o, d, hit.t, rng, [&](const Vec3& p, double maj) {
+      ctx_.media.eval(p, &mp);
+      if (!collide(mp, maj, beta, rng, &scatter_medium)) return true;
+      scatter_p = p;
+      return false;
+    });
+    if (escaped && to_surface) {
+      if (events == 0 && sample) record_surface_hit(ctx_, hit, beta, sample);
+      if (!reflect(hit, L, beta, wide, rng)) break;
+      if (max_events_ > 0 && events + 1 >= max_events_) break;
+      d = cosine_direction(hit.ns, rng.uniform(), rng.uniform());
+      if (dot(d, hit.ng) <= 0.0) break;  // below the geometric surface (shading normals): absorbed
+      o = SceneSurfaces::offset(hit.p, hit.ng, d);
+    } else if (escaped) {
       // Only camera rays see the environment directly; later escapes were counted by NEE.
       if (events == 0 && ctx_.has_environment) L += beta * ctx_.environment;
       break;
+    } else {
+      if (scatter_medium < 0 || max_component(beta) <= 0.0) break;
+      // Next-event estimation at the scattering vertex.
+      L += beta * direct_light(scatter_p, d, scatter_medium, wide, rng);
+      if (max_events_ > 0 && events + 1 >= max_events_) break;
+      if (!scatter(scatter_medium, d, wide, rng)) break;
+      o = scatter_p;
     }
-    if (scatter_medium < 0 || max_component(beta) <= 0.0) break;
-
-    // Next-event estimation at the scattering vertex.
-    L += beta * direct_light(scatter_p, d, scatter_medium, wide, rng);
-    if (max_events_ > 0 && events + 1 >= max_events_) break;
-
-    // Continue in a phase-sampled direction (weight f / pdf = 1).
-    const double u1 = rng.uniform(), u2 = rng.uniform();
-    const Vec3 d_new = phase_sample(ctx_.media.phase(scatter_medium), d, u1, u2);
-    if (!splits_.empty()) {
-      // Classify the scatter (probability = its wide share); paths over the limit end here.
-      const PhaseSplit& split = *splits_[scatter_medium];
-      const double mu = dot(d, d_new), p = phase_eval(ctx_.media.phase(scatter_medium), mu);
-      const double share = p > 0.0 ? (1.0 - split.f()) * split.wide(mu) / p : 1.0;
-      if (rng.uniform() < share && ++wide > *s_.max_wide_scatters) break;
-    }
-    d = d_new;
-    o = scatter_p;
 
     // Russian roulette on the largest channel of the throughput.
     if (events >= 3) {
@@ -148,6 +145,32 @@ Rgb PathTracer::Li(const Ray& ray, Rng& rng, CameraSample* sample) const {
     }
   }
   return L;
+}
+
+bool PathTracer::scatter(int medium, Vec3& d, int& wide, Rng& rng) const {
+  // Continue in a phase-sampled direction (weight f / pdf = 1).
+  const double u1 = rng.uniform(), u2 = rng.uniform();
+  const Vec3 d_new = phase_sample(ctx_.media.phase(medium), d, u1, u2);
+  if (!splits_.empty()) {
+    // Classify the scatter (probability = its wide share); paths over the limit end here.
+    const PhaseSplit& split = *splits_[medium];
+    const double mu = dot(d, d_new), p = phase_eval(ctx_.media.phase(medium), mu);
+    const double share = p > 0.0 ? (1.0 - split.f()) * split.wide(mu) / p : 1.0;
+    if (rng.uniform() < share && ++wide > *s_.max_wide_scatters) return false;
+  }
+  d = d_new;
+  return true;
+}
+
+bool PathTracer::reflect(const SurfaceHit& hit, Rgb& L, Rgb& beta, int& wide, Rng& rng) const {
+  const Material& material = ctx_.surfaces.material(hit.surface);
+  const auto* diffuse = std::get_if<DiffuseMaterial>(&material);
+  if (!diffuse) return false;  // a holdout: black, and the path ends
+  // A diffuse reflection is a wide scatter (with a wide-scatter limit).
+  if (!splits_.empty() && ++wide > *s_.max_wide_scatters) return false;
+  L += beta * surface_radiance(ctx_, hit, rng, nullptr);  // direct light and the environment
+  beta *= diffuse->albedo;
+  return max_component(beta) > 0.0;
 }
 
 }  // namespace nimbus

@@ -49,6 +49,12 @@ class PathTracer final : public Integrator {
   // Next-event estimate at a scattering vertex p of medium `medium`, the path travelling along d.
   // wide_scatters: wide scatters on the path so far (only used with a wide-scatter limit).
   Rgb direct_light(const Vec3& p, const Vec3& d, int medium, int wide_scatters, Rng& rng) const;
+  // Samples the continuation after a scatter in `medium`: d becomes the new direction. False when the
+  // path ends (over the wide-scatter limit).
+  bool scatter(int medium, Vec3& d, int& wide, Rng& rng) const;
+  // The path meets surface hit: adds its direct light to L and its albedo to beta. False when the path
+  // ends there (a holdout, over the wide-scatter limit, or black).
+  bool reflect(const SurfaceHit& hit, Rgb& L, Rgb& beta, int& wide, Rng& rng) const;
   // One collision of delta tracking with the media at a point (mp) under majorant maj, by history-aware
   // spectral tracking: updates the throughput beta. Returns false for a null collision (tracking goes
   // on), true when the flight ends here: a real scatter in medium *scatter_medium, or the path absorbed

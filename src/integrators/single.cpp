@@ -1,6 +1,7 @@
 #include "integrators/single.h"
 
 #include "core/json_reader.h"
+#include "integrators/surface_light.h"
 #include "integrators/tracking.h"
 #include "media/phase.h"
 #include "scene/lights.h"
@@ -38,53 +39,61 @@ SingleScatter::SingleScatter(const SceneContext& context, SingleSettings setting
 }
 
 Rgb SingleScatter::light_transmittance(size_t l, const Vec3& p, const LightSample& ls, Rng& rng) const {
-  if (!shadow_maps_.empty()) return shadow_maps_[l].lookup(p);
-  return ratio_tracking_transmittance(ctx_.media, ctx_.majorants, p, ls.wi, ls.distance, rng);
+  if (!shadow_maps_.empty())
+    return ctx_.surfaces.occluded(p, ls.wi, ls.distance) ? Rgb(0.0) : shadow_maps_[l].lookup(p);
+  return shadow_transmittance(ctx_, p, ls.wi, ls.distance, rng);
 }
 
 Rgb SingleScatter::Li(const Ray& ray, Rng& rng, CameraSample* sample) const {
+  return trace(ray, rng, sample, 1);
+}
+
+Rgb SingleScatter::trace(const Ray& ray, Rng& rng, CameraSample* sample, int bounces) const {
   const Vec3 &o = ray.o, &d = ray.d;
+  SurfaceHit hit;
+  const bool on_surface = ctx_.surfaces.intersect(o, d, std::numeric_limits<double>::infinity(), &hit);
   Rgb L(0.0), T(1.0);
   const double jitter = rng.uniform();
   MediumPoint mp;
-  march(ctx_.majorants, o, d, std::numeric_limits<double>::infinity(), s_.tau_step, jitter,
-        [&](const Vec3& p, double, double dt) {
-          ctx_.media.eval(p, &mp);
-          const Rgb step_T = exp(-mp.sigma_t() * dt);
-          if (max_component(mp.sigma_s) > 0.0) {
-            // Camera-side transmittance to the sample point, then single scattering towards the lights.
-            const Rgb T_here = T * exp(-mp.sigma_t() * (jitter * dt));
-            Rgb in_scatter(0.0);
-            for (int i = 0; i < mp.count; ++i) {
-              if (max_component(mp.sigma_s_i[i]) <= 0.0) continue;
-              const Phase& phase = ctx_.media.phase(i);
-              Rgb Li(0.0);
-              for (int s = 0; s < s_.light_samples; ++s) {
-                for (size_t l = 0; l < ctx_.lights.size(); ++l) {
-                  LightSample ls;
-                  const double u1 = rng.uniform(), u2 = rng.uniform();
-                  if (!sample_light(ctx_.lights[l], p, u1, u2, &ls)) continue;
-                  const double f = phase_eval(phase, dot(d, ls.wi));
-                  if (f <= 0.0) continue;
-                  Li += ls.weight * f * light_transmittance(l, p, ls, rng);
-                }
-                if (ctx_.has_environment) {
-                  const double u1 = rng.uniform(), u2 = rng.uniform();
-                  const Vec3 wi = phase_sample(phase, d, u1, u2);
-                  Li += ctx_.environment *
-                        ratio_tracking_transmittance(ctx_.media, ctx_.majorants, p, wi,
-                                                     std::numeric_limits<double>::infinity(), rng);
-                }
-              }
-              in_scatter += mp.sigma_s_i[i] * Li / double(s_.light_samples);
-            }
-            L += T_here * in_scatter * dt;
+  march(ctx_.majorants, o, d, hit.t, s_.tau_step, jitter, [&](const Vec3& p, double, double dt) {
+    ctx_.media.eval(p, &mp);
+    const Rgb step_T = exp(-mp.sigma_t() * dt);
+    if (max_component(mp.sigma_s) > 0.0) {
+      // Camera-side transmittance to the sample point, then single scattering towards the lights.
+      const Rgb T_here = T * exp(-mp.sigma_t() * (jitter * dt));
+      Rgb in_scatter(0.0);
+      for (int i = 0; i < mp.count; ++i) {
+        if (max_component(mp.sigma_s_i[i]) <= 0.0) continue;
+        const Phase& phase = ctx_.media.phase(i);
+        Rgb Li(0.0);
+        for (int s = 0; s < s_.light_samples; ++s) {
+          for (size_t l = 0; l < ctx_.lights.size(); ++l) {
+            LightSample ls;
+            const double u1 = rng.uniform(), u2 = rng.uniform();
+            if (!sample_light(ctx_.lights[l], p, u1, u2, &ls)) continue;
+            const double f = phase_eval(phase, dot(d, ls.wi));
+            if (f <= 0.0) continue;
+            Li += ls.weight * f * light_transmittance(l, p, ls, rng);
           }
-          T *= step_T;
-          return max_component(T) > 1e-6;
-        });
-  if (ctx_.has_environment) L += T * ctx_.environment;
-  return L;
+          if (ctx_.has_environment) {
+            const double u1 = rng.uniform(), u2 = rng.uniform();
+            const Vec3 wi = phase_sample(phase, d, u1, u2);
+            Li += ctx_.environment *
+                  shadow_transmittance(ctx_, p, wi, std::numeric_limits<double>::infinity(), rng);
+          }
+        }
+        in_scatter += mp.sigma_s_i[i] * Li / double(s_.light_samples);
+      }
+      L += T_here * in_scatter * dt;
+    }
+    T *= step_T;
+    return max_component(T) > 1e-6;
+  });
+  // The surface the ray ends on (lit directly, and by the light gathered along one more traced ray) or
+  // the environment.
+  const GatherFn gather = [&](const Ray& r) { return trace(r, rng, nullptr, bounces - 1); };
+  return L +
+         ray_end_radiance(ctx_, on_surface ? &hit : nullptr, T, rng, sample, bounces > 0 ? &gather : nullptr);
 }
 
 }  // namespace nimbus

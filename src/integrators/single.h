@@ -38,6 +38,8 @@ class SingleScatter final : public Integrator {
  public:
   SingleScatter(const SceneContext& context, SingleSettings settings);
   Rgb Li(const Ray& ray, Rng& rng, CameraSample* sample = nullptr) const override;
+  // Li with `bounces` more rays gathered at the surface the ray ends on (Li: 1).
+  Rgb trace(const Ray& ray, Rng& rng, CameraSample* sample, int bounces) const;
   nlohmann::json settings_json() const override { return to_json(s_); }
 
  private:

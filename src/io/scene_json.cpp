@@ -7,6 +7,7 @@
 
 #include "core/json_reader.h"
 #include "integrators/registry.h"
+#include "io/scene_surfaces.h"
 #include "io/scene_volumes.h"
 #include "media/media.h"
 #include "media/phase.h"
@@ -174,6 +175,9 @@ Scene parse_scene(const nlohmann::json& doc, const std::string& name, const std:
   if (media.size() > size_t(kMaxMedia))
     root.fail("media", fmt::format("at most {} media (got {})", kMaxMedia, media.size()));
   for (JsonObject& m : media) scene.media.push_back(parse_medium(m, base_dir));
+  if (root.has("surfaces"))
+    for (JsonObject& s : root.array_of_objects("surfaces", true))
+      scene.surfaces.push_back(parse_surface(s, base_dir));
   for (JsonObject& l : root.array_of_objects("lights", true)) scene.lights.push_back(parse_light(l));
   if (root.has("integrator"))
     scene.integrator = parse_integrator(doc["integrator"], root.object("integrator"));

@@ -3,7 +3,10 @@
 namespace nimbus {
 
 SceneContext::SceneContext(const Scene& scene, int majorant_resolution, bool global_majorant)
-    : media(scene.media), majorants(media, majorant_resolution, global_majorant), camera(scene.camera) {
+    : media(scene.media),
+      majorants(media, majorant_resolution, global_majorant),
+      surfaces(scene.surfaces),
+      camera(scene.camera) {
   for (const Light& l : scene.lights) {
     if (const auto* env = std::get_if<EnvironmentLight>(&l)) {
       environment += env->radiance;

@@ -1,4 +1,4 @@
-// What every integrator shares for one render: the media with their majorant grid, the camera and the
+// What every integrator shares for one render: the media with their majorant grid, the surfaces, the camera and the
 // lights (directional and point lights for next-event estimation; the environment as one radiance).
 #pragma once
 
@@ -9,6 +9,7 @@
 #include "media/media.h"
 #include "nimbus/scene.h"
 #include "scene/camera.h"
+#include "scene/surfaces.h"
 
 namespace nimbus {
 
@@ -16,6 +17,7 @@ struct SceneContext {
   explicit SceneContext(const Scene& scene, int majorant_resolution = 0, bool global_majorant = false);
   SceneMedia media;
   MajorantGrid majorants;
+  SceneSurfaces surfaces;
   PinholeCamera camera;
   std::vector<Light> lights;  // directional and point lights (sampled by NEE)
   Rgb environment{0.0};       // sum of environment lights' radiance

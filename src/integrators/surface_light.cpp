@@ -1,0 +1,61 @@
+// Light at surfaces (integrators/surface_light.h).
+#include "integrators/surface_light.h"
+
+#include "integrators/tracking.h"
+#include "scene/lights.h"
+
+namespace nimbus {
+
+Rgb shadow_transmittance(const SceneContext& ctx, const Vec3& p, const Vec3& w, double tmax, Rng& rng) {
+  if (ctx.surfaces.occluded(p, w, tmax)) return Rgb(0.0);
+  return ratio_tracking_transmittance(ctx.media, ctx.majorants, p, w, tmax, rng);
+}
+
+Rgb surface_direct_light(const SceneContext& ctx, const SurfaceHit& hit, const Rgb& albedo, Rng& rng) {
+  Rgb E(0.0);  // cosine-weighted irradiance / pi
+  for (const Light& light : ctx.lights) {
+    LightSample ls;
+    const double u1 = rng.uniform(), u2 = rng.uniform();
+    if (!sample_light(light, hit.p, u1, u2, &ls)) continue;
+    const double cos_theta = dot(hit.ns, ls.wi);
+    if (cos_theta <= 0.0 || dot(hit.ng, ls.wi) <= 0.0) continue;
+    const Vec3 o = SceneSurfaces::offset(hit.p, hit.ng, ls.wi);
+    E += ls.weight * shadow_transmittance(ctx, o, ls.wi, ls.distance, rng) * (cos_theta / kPi);
+  }
+  return albedo * E;
+}
+
+Rgb surface_radiance(const SceneContext& ctx, const SurfaceHit& hit, Rng& rng, const GatherFn* gather) {
+  const auto* diffuse = std::get_if<DiffuseMaterial>(&ctx.surfaces.material(hit.surface));
+  if (!diffuse) return Rgb(0.0);  // a holdout
+  Rgb L = surface_direct_light(ctx, hit, diffuse->albedo, rng);
+  if (!gather && !ctx.has_environment) return L;
+  const double u1 = rng.uniform(), u2 = rng.uniform();
+  const Vec3 wi = cosine_direction(hit.ns, u1, u2);
+  if (dot(hit.ng, wi) <= 0.0) return L;
+  const Vec3 o = SceneSurfaces::offset(hit.p, hit.ng, wi);
+  if (gather) return L + diffuse->albedo * (*gather)(Ray{o, wi});
+  return L + diffuse->albedo * ctx.environment *
+                 shadow_transmittance(ctx, o, wi, std::numeric_limits<double>::infinity(), rng);
+}
+
+Rgb ray_end_radiance(const SceneContext& ctx, const SurfaceHit* hit, const Rgb& T, Rng& rng,
+                     CameraSample* sample, const GatherFn* gather) {
+  if (!hit) return ctx.has_environment ? T * ctx.environment : Rgb(0.0);
+  if (sample) record_surface_hit(ctx, *hit, T, sample);
+  if (max_component(T) <= 0.0) return Rgb(0.0);
+  return T * surface_radiance(ctx, *hit, rng, gather);
+}
+
+void record_surface_hit(const SceneContext& ctx, const SurfaceHit& hit, const Rgb& T, CameraSample* sample) {
+  sample->escape_transmittance = Rgb(0.0);
+  sample->depth = hit.t;
+  sample->normal = hit.ns;
+  if (const auto* diffuse = std::get_if<DiffuseMaterial>(&ctx.surfaces.material(hit.surface))) {
+    sample->albedo = diffuse->albedo;
+  } else {
+    sample->holdout_transmittance = T;
+  }
+}
+
+}  // namespace nimbus

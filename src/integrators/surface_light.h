@@ -1,0 +1,39 @@
+// Light at opaque surfaces, shared by the integrators: shadow rays that see surfaces and media, the
+// direct light on a diffuse surface point, and the light leaving a surface that a camera ray ends on.
+#pragma once
+
+#include <functional>
+
+#include "integrators/integrator.h"
+#include "scene/surfaces.h"
+
+namespace nimbus {
+
+// Transmittance from p along w (unit) over (0, tmax): 0 when a surface blocks the way, else the media's
+// by ratio tracking (unbiased).
+Rgb shadow_transmittance(const SceneContext& ctx, const Vec3& p, const Vec3& w, double tmax, Rng& rng);
+
+// (albedo / pi) times the cosine-weighted irradiance at a diffuse surface point from every directional and
+// point light (light sampling, one sample each), through shadow_transmittance. hit.ns faces the viewer;
+// the surface is two-sided, lit on the viewer's side only.
+Rgb surface_direct_light(const SceneContext& ctx, const SurfaceHit& hit, const Rgb& albedo, Rng& rng);
+
+// The radiance that leaves a surface point towards the ray that found it, for the integrators that march
+// the camera ray (single, octave, mfs): 0 for a holdout; for a diffuse surface its direct light plus
+// albedo times the radiance arriving along one cosine-sampled direction (weight albedo: (albedo / pi)
+// cos / (cos / pi)). `gather(ray)` is that radiance as the integrator itself computes it along a ray (the
+// medium's scattered light, the environment and surfaces behind, with their direct light); without a
+// gather (nullptr), only the environment through the media is gathered.
+using GatherFn = std::function<Rgb(const Ray&)>;
+Rgb surface_radiance(const SceneContext& ctx, const SurfaceHit& hit, Rng& rng, const GatherFn* gather);
+
+// The light at the end of a marched ray, seen through its transmittance T: the surface it ends on (hit,
+// through surface_radiance with `gather`; its layers recorded into a non-null sample), or with
+// hit == nullptr the environment.
+Rgb ray_end_radiance(const SceneContext& ctx, const SurfaceHit* hit, const Rgb& T, Rng& rng,
+                     CameraSample* sample, const GatherFn* gather);
+
+// The compositing layers of a camera ray ending on a surface, seen through transmittance T.
+void record_surface_hit(const SceneContext& ctx, const SurfaceHit& hit, const Rgb& T, CameraSample* sample);
+
+}  // namespace nimbus
