@@ -113,7 +113,7 @@ void BeamPhotons::trace(size_t j, Rng& rng, PhotonBatch& batch) const {
   // continuous loss exp(-int sigma_loss) on the weight (zero variance in a uniform medium).
   const auto peak_share = [&](int i) { return peak_fraction[i]; };
   walk_photon(
-      ctx.majorants, ph.x, ph.w, rng, &batch.collisions,
+      ctx, ph.x, ph.w, rng, &batch.collisions,
       [&](const Vec3& p) {
         ctx.media.eval(p, &walk.mp);
         return scattering_shares(walk.mp, ctx.media.count(), walk.c, peak_share).sum;

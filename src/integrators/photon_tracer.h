@@ -63,17 +63,20 @@ std::vector<float> trace_photons(size_t total, uint64_t stream_seed, size_t tall
                                  const TracePhoton& trace_photon, uint64_t* rejection_failures);
 
 // Flies a photon from x along w: delta tracking with real collisions at density sigma(p) (<= the
-// majorant); on_flight(x, w, t_end) for each flight (t_end infinite when the photon leaves the media),
+// majorant); on_flight(x, w, t_end) for each flight (t_end infinite when the photon leaves the media;
+// a flight that meets a surface ends there, and the photon with it: surfaces absorb photons),
 // then on_collision(xc, &w) -> bool at each real collision xc (false ends the photon; it may turn w).
 // At most kMaxPhotonEvents collisions; each one that does not end the photon adds 1 to *collisions.
 template <typename Sigma, typename OnFlight, typename OnCollision>
-void walk_photon(const MajorantGrid& majorants, Vec3 x, Vec3 w, Rng& rng, double* collisions, Sigma&& sigma,
+void walk_photon(const SceneContext& ctx, Vec3 x, Vec3 w, Rng& rng, double* collisions, Sigma&& sigma,
                  OnFlight&& on_flight, OnCollision&& on_collision) {
   constexpr double kInf = std::numeric_limits<double>::infinity();
   for (int events = 0; events < kMaxPhotonEvents; ++events, *collisions += 1.0) {
     bool hit = false;
     Vec3 xc;
-    track(majorants, x, w, kInf, rng, [&](const Vec3& p, double maj) {
+    SurfaceHit surface;
+    const bool to_surface = ctx.surfaces.intersect(x, w, kInf, &surface);
+    const bool reached = track(ctx.majorants, x, w, surface.t, rng, [&](const Vec3& p, double maj) {
       const double s = sigma(p);
       NIMBUS_DCHECK(s >= 0.0 && s <= maj);  // a real collision's probability s / maj in [0, 1]
       if (rng.uniform() * maj < s) {
@@ -83,6 +86,10 @@ void walk_photon(const MajorantGrid& majorants, Vec3 x, Vec3 w, Rng& rng, double
       }
       return true;
     });
+    if (reached && to_surface) {
+      on_flight(x, w, surface.t);
+      return;
+    }
     on_flight(x, w, hit ? (xc - x).length() : kInf);
     if (!hit || !on_collision(xc, &w)) return;
     NIMBUS_DCHECK(std::abs(w.length() - 1.0) < 1e-6);
