@@ -121,7 +121,9 @@ void BeamPhotons::trace(size_t j, Rng& rng, PhotonBatch& batch) const {
       [&](const Vec3& x, const Vec3& w, double t_end) {
         walk.weight = deposit(batch.tally, x, w, t_end, walk.weight, walk.c, false);
       },
-      [&](const Vec3& xc, Vec3* w) { return scatter(xc, w, walk, rng, batch); });
+      [&](const Vec3& xc, Vec3* w) { return scatter(xc, w, walk, rng, batch); },
+      // A reflection is a wide scatter: not part of the forward-peaked beam.
+      [](const SurfaceHit&, Vec3*) { return false; });
 }
 
 // A peak scatter at xc: roulette, medium, direction (from P_peak). False ends the photon.

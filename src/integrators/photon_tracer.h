@@ -64,12 +64,13 @@ std::vector<float> trace_photons(size_t total, uint64_t stream_seed, size_t tall
 
 // Flies a photon from x along w: delta tracking with real collisions at density sigma(p) (<= the
 // majorant); on_flight(x, w, t_end) for each flight (t_end infinite when the photon leaves the media;
-// a flight that meets a surface ends there, and the photon with it: surfaces absorb photons),
+// a flight that meets a surface ends there and on_surface(hit, &w) -> bool decides: false absorbs the
+// photon, true sends it on along the new w from the surface),
 // then on_collision(xc, &w) -> bool at each real collision xc (false ends the photon; it may turn w).
 // At most kMaxPhotonEvents collisions; each one that does not end the photon adds 1 to *collisions.
-template <typename Sigma, typename OnFlight, typename OnCollision>
+template <typename Sigma, typename OnFlight, typename OnCollision, typename OnSurface>
 void walk_photon(const SceneContext& ctx, Vec3 x, Vec3 w, Rng& rng, double* collisions, Sigma&& sigma,
-                 OnFlight&& on_flight, OnCollision&& on_collision) {
+                 OnFlight&& on_flight, OnCollision&& on_collision, OnSurface&& on_surface) {
   constexpr double kInf = std::numeric_limits<double>::infinity();
   for (int events = 0; events < kMaxPhotonEvents; ++events, *collisions += 1.0) {
     bool hit = false;
@@ -88,7 +89,9 @@ void walk_photon(const SceneContext& ctx, Vec3 x, Vec3 w, Rng& rng, double* coll
     });
     if (reached && to_surface) {
       on_flight(x, w, surface.t);
-      return;
+      if (!on_surface(surface, &w)) return;
+      x = SceneSurfaces::offset(surface.p, surface.ng, w);
+      continue;
     }
     on_flight(x, w, hit ? (xc - x).length() : kInf);
     if (!hit || !on_collision(xc, &w)) return;

@@ -94,6 +94,7 @@ struct ScatterPhotons {
   int K;  // flights after wide scatter 1 .. K - 1 are kept
 
   void trace(size_t j, Rng& rng, PhotonBatch& batch) const;
+  bool reflect(const SurfaceHit& hit, Vec3* w, int c, double* weight, int* order, Rng& rng) const;
   bool scatter(const Vec3& xc, Vec3* w, int c, double* weight, int* order, Rng& rng,
                PhotonBatch& batch) const;
 };
@@ -121,7 +122,24 @@ void ScatterPhotons::trace(size_t j, Rng& rng, PhotonBatch& batch) const {
       [&](const Vec3& x, const Vec3& w, double t_end) {
         if (order >= first_order) deposit_flight(batch.tally, grid, bands, x, w, t_end, power * weight);
       },
-      [&](const Vec3& xc, Vec3* w) { return scatter(xc, w, c, &weight, &order, rng, batch); });
+      [&](const Vec3& xc, Vec3* w) { return scatter(xc, w, c, &weight, &order, rng, batch); },
+      [&](const SurfaceHit& hit, Vec3* w) { return reflect(hit, w, c, &weight, &order, rng); });
+}
+
+// A photon of channel c meets a surface: a diffuse one reflects it (a wide scatter: its albedo as
+// weight, with roulette, a cosine-distributed direction on the side it came from); a holdout absorbs it.
+bool ScatterPhotons::reflect(const SurfaceHit& hit, Vec3* w, int c, double* weight, int* order,
+                             Rng& rng) const {
+  const auto* diffuse = std::get_if<DiffuseMaterial>(&ctx.surfaces.material(hit.surface));
+  if (!diffuse || ++*order >= K) return false;
+  *weight *= diffuse->albedo[c];
+  if (*weight < 0.1) {
+    if (rng.uniform() * 0.1 >= *weight) return false;
+    *weight = 0.1;
+  }
+  const double v1 = rng.uniform(), v2 = rng.uniform();
+  *w = cosine_direction(hit.ns, v1, v2);
+  return dot(*w, hit.ng) > 0.0;
 }
 
 // A real collision at xc of a photon of channel c: albedo weight, roulette, medium, direction.
