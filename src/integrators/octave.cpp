@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "core/json_reader.h"
+#include "integrators/camera_layers.h"
 #include "integrators/tracking.h"
 #include "media/phase.h"
 #include "scene/lights.h"
@@ -97,7 +98,8 @@ Rgb OctaveIntegrator::Li(const Ray& ray, Rng& rng, CameraSample* sample) const {
     bj[j] = std::pow(s_.b, j);
   }
   // Camera-side optical depth from the camera (octave j sees exp(-b^j tau)).
-  Rgb L(0.0), tau(0.0);
+  Rgb L(0.0), tau(0.0), direct(0.0);  // direct: octave 0, the exact single scattering
+  MarchRecorder layers(sample);
   const double jitter = rng.uniform();
   MediumPoint mp;
   LightSamples lights;
@@ -105,8 +107,9 @@ Rgb OctaveIntegrator::Li(const Ray& ray, Rng& rng, CameraSample* sample) const {
   lights.T.resize(ctx_.lights.size());
   lights.ok.resize(ctx_.lights.size());
   march(ctx_.majorants, o, d, std::numeric_limits<double>::infinity(), s_.tau_step, jitter,
-        [&](const Vec3& p, double, double dt) {
+        [&](const Vec3& p, double t, double dt) {
           ctx_.media.eval(p, &mp);
+          Rgb L_step(0.0);
           if (max_component(mp.sigma_s) > 0.0) {
             const Rgb tau_here = tau + mp.sigma_t() * (jitter * dt);
             // Light transmittance exp(-tau_l) once per light (octave j: raised to b^j).
@@ -120,12 +123,18 @@ Rgb OctaveIntegrator::Li(const Ray& ray, Rng& rng, CameraSample* sample) const {
               Rgb Tc;
               for (int c = 0; c < 3; ++c) Tc[c] = std::exp(-bj[j] * tau_here[c]);
               if (max_component(Tc) < 1e-7) continue;
-              L += Tc * octave_scatter(j, bj[j], p, d, mp, lights, rng) * (aj[j] * dt);
+              const Rgb Lj = Tc * octave_scatter(j, bj[j], p, d, mp, lights, rng) * (aj[j] * dt);
+              L += Lj;
+              L_step += Lj;
+              if (j == 0) direct += Lj;
             }
           }
+          const Rgb T0 = exp(-tau);
           tau += mp.sigma_t() * dt;
+          layers.step(t - jitter * dt, dt, T0, exp(-tau), mp, L_step);
           return min_component(tau) * bj[N - 1] < 14.0;
         });
+  layers.finish(ctx_, exp(-tau), direct);
   if (ctx_.has_environment) L += exp(-tau) * ctx_.environment;
   return L;
 }

@@ -1,6 +1,7 @@
 #include "integrators/single.h"
 
 #include "core/json_reader.h"
+#include "integrators/camera_layers.h"
 #include "integrators/tracking.h"
 #include "media/phase.h"
 #include "scene/lights.h"
@@ -47,10 +48,12 @@ Rgb SingleScatter::Li(const Ray& ray, Rng& rng, CameraSample* sample) const {
   Rgb L(0.0), T(1.0);
   const double jitter = rng.uniform();
   MediumPoint mp;
+  MarchRecorder layers(sample);  // depth, albedo and deep segments when the film asks
   march(ctx_.majorants, o, d, std::numeric_limits<double>::infinity(), s_.tau_step, jitter,
-        [&](const Vec3& p, double, double dt) {
+        [&](const Vec3& p, double t, double dt) {
           ctx_.media.eval(p, &mp);
           const Rgb step_T = exp(-mp.sigma_t() * dt);
+          Rgb L_step(0.0);
           if (max_component(mp.sigma_s) > 0.0) {
             // Camera-side transmittance to the sample point, then single scattering towards the lights.
             const Rgb T_here = T * exp(-mp.sigma_t() * (jitter * dt));
@@ -78,11 +81,14 @@ Rgb SingleScatter::Li(const Ray& ray, Rng& rng, CameraSample* sample) const {
               }
               in_scatter += mp.sigma_s_i[i] * Li / double(s_.light_samples);
             }
-            L += T_here * in_scatter * dt;
+            L_step = T_here * in_scatter * dt;
+            L += L_step;
           }
+          layers.step(t - jitter * dt, dt, T, T * step_T, mp, L_step);
           T *= step_T;
           return max_component(T) > 1e-6;
         });
+  layers.finish(ctx_, T, L);  // all of single's light is direct
   if (ctx_.has_environment) L += T * ctx_.environment;
   return L;
 }
