@@ -59,7 +59,13 @@ TEST(Deep, FlattenedDeepImageIsTheFlatRgba) {
     "lights": )" + lights + ", \"film\": {\"transparent\": true}}");
   for (const char* type : {"pathtrace", "single", "octave", "mfs"}) {
     doc["integrator"] = {{"type", type}, {"spp", 3}, {"seed", 2}};
-    if (std::string(type) == "mfs") doc["integrator"]["photons"] = 4000;
+    if (std::string(type) == "mfs" || std::string(type) == "octave")
+      doc["integrator"]["shadow_map_resolution"] = 16;
+    if (std::string(type) == "mfs") {
+      doc["integrator"]["photons"] = 4000;
+      doc["integrator"]["scatter_grid_resolution"] = 8;
+      doc["integrator"]["beam_photons"] = 0;
+    }
     RenderOptions options;
     options.threads = 2;
     options.deep_samples = 8;

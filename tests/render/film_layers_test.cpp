@@ -119,6 +119,68 @@ TEST(FilmLayers, HalfTransmittanceFractionSolvesTheStep) {
   EXPECT_NEAR(average(Tu), 0.5, 1e-8);
 }
 
+TEST(FilmLayers, DirectIsTheUnscatteredAndSingleScatteredLight) {
+  const Scene scene = test::scene_from_json(sphere_scene(1.5, 0.2, kSun + ", " + kSky));
+  const SceneContext ctx(scene);
+  const Ray ray{Vec3(0, -5, 0), normalize(Vec3(0.1, 5, 0.2))};
+  auto make = [&](const std::string& type, nlohmann::json options, int max_events = 0) {
+    IntegratorSettings settings;
+    settings.type = type;
+    settings.max_events = max_events;
+    settings.options = std::move(options);
+    return make_integrator(ctx, settings);
+  };
+  // Where an integrator's whole image is direct light, direct is Li: single; pathtrace with one event;
+  // octave with one octave (its octave 0 is single scattering); mfs with one wide scatter and no
+  // environment (no scatter grid) is tested below.
+  const std::pair<std::unique_ptr<Integrator>, std::string> all_direct[] = {
+      {make("single", nlohmann::json::object()), "single"},
+      {make("pathtrace", nlohmann::json::object(), 1), "pathtrace max_events 1"},
+      {make("octave", {{"octaves", 1}}), "octave 1"}};
+  for (const auto& [integrator, name] : all_direct) {
+    for (int i = 0; i < 20; ++i) {
+      Rng rng(7, uint64_t(i));
+      CameraSample s;
+      const Rgb L = integrator->Li(ray, rng, &s);
+      for (int c = 0; c < 3; ++c) EXPECT_NEAR(s.direct[c], L[c], 1e-12 * (1.0 + L[c])) << name;
+    }
+  }
+  // pathtrace's direct (background + first NEE) estimates single's image: the same mean.
+  const auto pt = make("pathtrace", nlohmann::json::object());
+  const auto single = make("single", {{"tau_step", 0.05}});
+  test::MeanAccumulator direct[3], reference[3];
+  for (int i = 0; i < 8000; ++i) {
+    Rng r1(1, uint64_t(i));
+    CameraSample s;
+    pt->Li(ray, r1, &s);
+    for (int c = 0; c < 3; ++c) direct[c].add(s.direct[c]);
+  }
+  for (int i = 0; i < 1000; ++i) {
+    Rng r2(2, uint64_t(i));
+    const Rgb L = single->Li(ray, r2);
+    for (int c = 0; c < 3; ++c) reference[c].add(L[c]);
+  }
+  for (int c = 0; c < 3; ++c)
+    EXPECT_NEAR(
+        direct[c].mean, reference[c].mean,
+        5 * std::hypot(direct[c].stderr_mean(), reference[c].stderr_mean()) + 0.005 * reference[c].mean)
+        << c;
+}
+
+TEST(FilmLayers, MfsDirectIsEverythingWithoutTheScatterGrid) {
+  const Scene scene = test::scene_from_json(sphere_scene(1.5, 0.2, kSun));
+  const SceneContext ctx(scene);
+  IntegratorSettings settings;
+  settings.type = "mfs";
+  settings.options = {{"large_angle_scatters", 1}, {"beam_photons", 0}};
+  const auto mfs = make_integrator(ctx, settings);
+  Rng rng(3, 1);
+  CameraSample s;
+  const Rgb L = mfs->Li({Vec3(0, -5, 0), normalize(Vec3(0.1, 5, 0.2))}, rng, &s);
+  EXPECT_GT(L[0], 0.0);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(s.direct[c], L[c], 1e-12);
+}
+
 RenderResult render_with(const std::string& text, const std::string& type, const nlohmann::json& film) {
   nlohmann::json doc = nlohmann::json::parse(text);
   doc["integrator"] = {{"type", type}, {"spp", 4}, {"seed", 5}};
