@@ -37,17 +37,19 @@ double sample_alpha(const CameraSample& s, bool background_opaque) {
   return 1.0 - average(s.holdout_transmittance) - (background_opaque ? 0.0 : average(s.escape_transmittance));
 }
 
+void check_film_layers(const std::vector<std::string>& layers) {
+  const std::vector<std::string>& known = film_layer_names();
+  for (auto it = layers.begin(); it != layers.end(); ++it) {
+    if (std::find(known.begin(), known.end(), *it) == known.end())
+      throw Error(fmt::format("unknown film layer '{}' (known: {})", *it, fmt::join(known, ", ")));
+    if (std::find(layers.begin(), it, *it) != it)
+      throw Error(fmt::format("film layer '{}' named twice", *it));
+  }
+}
+
 FilmLayers::FilmLayers(Film& film, const FilmSettings& settings, bool has_environment)
     : transparent_(settings.transparent), background_opaque_(has_environment && !settings.transparent) {
-  const std::vector<std::string>& known = film_layer_names();
-  for (size_t i = 0; i < settings.layers.size(); ++i) {
-    const std::string& name = settings.layers[i];
-    if (std::find(known.begin(), known.end(), name) == known.end())
-      throw Error(fmt::format("unknown film layer '{}' (known: {})", name, fmt::join(known, ", ")));
-    if (std::find(settings.layers.begin(), settings.layers.begin() + long(i), name) !=
-        settings.layers.begin() + long(i))
-      throw Error(fmt::format("film layer '{}' named twice", name));
-  }
+  check_film_layers(settings.layers);
   alpha_ = film.add_layer("alpha", 1);
   if (wants(settings, "depth")) depth_ = film.add_layer("depth", 2);  // sum of finite depths, their count
   if (wants(settings, "transmittance")) transmittance_ = film.add_layer("transmittance", 3);

@@ -20,10 +20,12 @@ namespace nimbus {
 // background (the channel mean, as compositors take one alpha for three colours).
 double sample_alpha(const CameraSample& s, bool background_opaque);
 
+// Throws nimbus::Error for a layer name not in film_layer_names() or named twice.
+void check_film_layers(const std::vector<std::string>& layers);
+
 class FilmLayers {
  public:
-  // Adds the layers `settings` asks for (and alpha, always) to `film`. Throws nimbus::Error for a name
-  // not in film_layer_names() or named twice.
+  // Adds the layers `settings` asks for (and alpha, always) to `film` (check_film_layers first).
   FilmLayers(Film& film, const FilmSettings& settings, bool has_environment);
 
   // Whether any layer needs the sample's depth or albedo.

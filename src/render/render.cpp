@@ -42,8 +42,9 @@ IntegratorSettings resolve_settings(const Scene& scene, const RenderOptions& opt
     throw Error(fmt::format("spp must be between 1 and {}", kMaxSpp));
   if (options.threads < 0) throw Error("threads must be >= 0");
   if (options.tile_size < 1) throw Error("tile size must be >= 1");
+  if (options.layers) check_film_layers(*options.layers);  // before any precomputation
   if (options.deep_samples < 0 || options.deep_samples > kMaxDeepSamples)
-    throw Error(fmt::format("deep samples must be between 1 and {}", kMaxDeepSamples));
+    throw Error(fmt::format("deep samples must be between 1 and {} (0: no deep image)", kMaxDeepSamples));
   return settings;
 }
 
