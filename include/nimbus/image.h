@@ -1,8 +1,10 @@
-// Images: linear float RGB in memory, written as EXR (float channels, ZIP) or as an sRGB PNG preview.
-// Every write is atomic (temporary file in the same folder, then rename): an existing file is never
-// replaced by a half-written one, and a failed write leaves it untouched.
+// Images: linear float RGB (and optionally alpha and named layers) in memory, written as EXR (float
+// channels, ZIP) or as an sRGB PNG preview; deep images (per-pixel lists of samples in depth) written as
+// deep scanline EXR. Every write is atomic (temporary file in the same folder, then rename): an existing
+// file is never replaced by a half-written one, and a failed write leaves it untouched.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <string>
 #include <utility>
@@ -10,9 +12,19 @@
 
 namespace nimbus {
 
+// One further EXR channel: its full name ("Z", "direct.R", ...) and one float per pixel, row-major.
+struct ImageChannel {
+  std::string name;
+  std::vector<float> data;
+};
+
 struct Image {  // linear RGB, row-major, row 0 = top, 3 floats per pixel
   int width = 0, height = 0;
   std::vector<float> rgb;
+  // Coverage, one float per pixel, or empty (an RGB image). With alpha, rgb is premultiplied by it.
+  std::vector<float> alpha;
+  // Further channels for the EXR (the compositing layers); PNG output ignores them.
+  std::vector<ImageChannel> channels;
   Image() = default;
   Image(int w, int h);  // zero-filled; throws nimbus::Error for sizes <= 0 or over 2^28 pixels
   float* pixel(int x, int y) { return &rgb[(size_t(y) * width + x) * 3]; }
@@ -22,11 +34,13 @@ struct Image {  // linear RGB, row-major, row 0 = top, 3 floats per pixel
 // String attributes of an EXR header, e.g. {"nimbus/scene", "{...}"}.
 using ImageMetadata = std::vector<std::pair<std::string, std::string>>;
 
+// R, G, B, then A when the image has alpha, then its further channels (OpenEXR stores them sorted by name).
 void write_exr(const std::filesystem::path& path, const Image& img, const ImageMetadata& meta = {});
-// Reads R, G, B (any pixel type; a missing channel reads as 0) and the string attributes.
+// Reads R, G, B (any pixel type; a missing channel reads as 0), A when present, and the string
+// attributes; further channels are not read.
 Image read_exr(const std::filesystem::path& path, ImageMetadata* meta = nullptr);
-// 8-bit sRGB (the sRGB transfer function, not a 2.2 gamma) of the image scaled by 2^exposure;
-// values are clamped to [0, 1] and non-finite values written as 0.
+// 8-bit sRGB (the sRGB transfer function, not a 2.2 gamma) of the RGB scaled by 2^exposure (premultiplied
+// colour: the image over black); values are clamped to [0, 1] and non-finite values written as 0.
 void write_png(const std::filesystem::path& path, const Image& img, double exposure_stops = 0.0);
 // By extension: .exr or .png (any case); anything else is an error.
 void write_image(const std::filesystem::path& path, const Image& img, const ImageMetadata& meta,
@@ -34,5 +48,25 @@ void write_image(const std::filesystem::path& path, const Image& img, const Imag
 
 // sRGB encoding of a linear value in [0, 1] (IEC 61966-2-1).
 double srgb_encode(double linear);
+
+// One deep sample: the depth range [z, z_back] along the camera ray and its own premultiplied colour
+// and alpha (an EXR deep sample: composited front to back with "over").
+struct DeepSample {
+  float z = 0.0f, z_back = 0.0f;
+  float r = 0.0f, g = 0.0f, b = 0.0f, a = 0.0f;
+};
+// Per pixel (row-major, row 0 = top) a list of deep samples sorted front to back:
+// samples[offsets[i] .. offsets[i + 1]) belong to pixel i.
+struct DeepImage {
+  int width = 0, height = 0;
+  std::vector<uint64_t> offsets;  // width * height + 1 entries
+  std::vector<DeepSample> samples;
+};
+
+// A deep scanline EXR with channels Z, ZBack, R, G, B, A (float), ZIP-compressed.
+void write_deep_exr(const std::filesystem::path& path, const DeepImage& img, const ImageMetadata& meta = {});
+DeepImage read_deep_exr(const std::filesystem::path& path);
+// Composites each pixel's samples front to back ("over"): the flat premultiplied RGBA.
+Image flatten(const DeepImage& img);
 
 }  // namespace nimbus

@@ -122,12 +122,28 @@ struct IntegratorSettings {
   nlohmann::json options = nlohmann::json::object();
 };
 
+// The compositing layers a film can keep besides RGBA (docs/compositing.md names their EXR channels).
+inline const std::vector<std::string>& film_layer_names() {
+  static const std::vector<std::string> names = {"depth",  "transmittance", "direct", "indirect",
+                                                 "albedo", "normal",        "samples"};
+  return names;
+}
+
+// What the image holds besides the beauty: `transparent` leaves the environment out of the colour and
+// the alpha (the environment is then a plate to be composited behind); `layers` names further EXR
+// layers from film_layer_names(), each at most once.
+struct FilmSettings {
+  bool transparent = false;
+  std::vector<std::string> layers;
+};
+
 struct Scene {
   Camera camera;
   std::vector<Medium> media;
   std::vector<Surface> surfaces;
   std::vector<Light> lights;
   IntegratorSettings integrator;
+  FilmSettings film;
   std::filesystem::path file;  // where it was read from (empty for built-in scenes)
   nlohmann::json source;       // the JSON it was read from, for image metadata
 };

@@ -6,6 +6,7 @@
 
 #include <limits>
 #include <nlohmann/json.hpp>
+#include <vector>
 
 #include "core/math.h"
 #include "core/ray.h"
@@ -13,6 +14,15 @@
 #include "scene/context.h"
 
 namespace nimbus {
+
+// A stretch [t0, t1] of a camera ray (t1 == t0: a point) and what it adds to the pixel as seen from the
+// camera: radiance L (already attenuated by the transmittance in front of it) and alpha, the mean
+// transmittance it removes. A deep image is made of them (src/render/deep.h).
+struct DeepSegment {
+  double t0 = 0.0, t1 = 0.0;
+  Rgb L{0.0};
+  double alpha = 0.0;
+};
 
 // What one camera sample tells the film beyond its radiance: the compositing layers. Every field is a
 // one-sample estimate whose pixel mean is the layer (an integrator may fill it with an unbiased
@@ -38,6 +48,14 @@ struct CameraSample {
   // depth is taken, and the shading normal of the first surface (0 in a volume).
   Rgb albedo{0.0};
   Vec3 normal{0.0, 0.0, 0.0};
+
+  // Set by the driver (the film layers work; not layers themselves). depth_wanted: the film keeps
+  // depth or albedo (an integrator may skip work done only for them: pathtrace's depth march). deep:
+  // where an integrator appends the camera ray's DeepSegments, front to back, whose L sum to
+  // Li - background and whose alpha sum to 1 - mean(escape_transmittance) - mean(holdout_transmittance);
+  // null when no deep image is made.
+  bool depth_wanted = true;
+  std::vector<DeepSegment>* deep = nullptr;
 };
 
 class Integrator {

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include "core/json_reader.h"
+#include "integrators/camera_layers.h"
 #include "integrators/mfs_estimators.h"
 #include "integrators/surface_light.h"
 #include "integrators/tracking.h"
@@ -149,6 +150,8 @@ Rgb MfsIntegrator::trace(const Ray& ray, Rng& rng, CameraSample* sample, int bou
   CameraPath cam;  // from the camera to the current step: T_full, T_red, tau_p, theta_p, tau_red, m0..m2
   const double jitter = rng.uniform();
   MediumPoint mp;
+  MarchRecorder layers(sample);  // direct: the lights' light that took at most one wide scatter
+  Rgb direct(0.0);
   march_growing(
       ctx_.majorants, o, d, hit.t, s_.tau_step, jitter,
       // Steps grow with the camera-side reduced depth: tau_step (1 + step_growth tau_red) (eq. D13).
@@ -157,28 +160,38 @@ Rgb MfsIntegrator::trace(const Ray& ray, Rng& rng, CameraSample* sample, int bou
         // Split the extinction at p into peak and reduced parts (eq. D2).
         ctx_.media.eval(p, &mp);
         const MfsExtinction k = mfs_extinction(mp, f_, theta2_);
+        Rgb L_step(0.0);
         // Add what each medium scatters towards the camera at the sample point y = p.
         if (max_component(mp.sigma_s) > 0.0) {
           const CameraPoint y = cam.at(k, jitter, dt, s_.light_side(), s_.path_lengthening);
-          Rgb in_scatter(0.0), peak_scatter(0.0);  // reach the camera through y.T_cam / y.T_full
+          Rgb in_scatter(0.0), peak_scatter(0.0), lights_scatter(0.0);  // via y.T_cam / y.T_full
           for (int i = 0; i < mp.count; ++i) {
             if (max_component(mp.sigma_s_i[i]) <= 0.0) continue;
             const MediumRadiance Lm = medium_radiance(i, p, d, t, y, cam, rng);
             in_scatter += mp.sigma_s_i[i] * Lm.L;
             peak_scatter += mp.sigma_s_i[i] * Lm.L_peak;
+            lights_scatter += mp.sigma_s_i[i] * Lm.L_lights;
           }
-          L += (y.T_cam * in_scatter + y.T_full * peak_scatter) * dt;
+          L_step = (y.T_cam * in_scatter + y.T_full * peak_scatter) * dt;
+          L += L_step;
+          direct += (y.T_cam * lights_scatter + y.T_full * peak_scatter) * dt;
         }
         // Advance the camera-side state over the whole step.
+        const Rgb T0 = s_.light_side() ? cam.T_full : cam.T_red;
         cam.advance(k, t, dt, jitter);
+        layers.step(t - jitter * dt, dt, T0, s_.light_side() ? cam.T_full : cam.T_red, mp, L_step);
         return max_component(s_.light_side() ? cam.T_full : cam.T_red) > 1e-6;
       });
   // Add the surface the ray ends on (lit directly and by one gathered ray) or the environment behind the
   // medium (its scattered light is in the grid). Camera side: light smooth in angle keeps its
   // peak-scattered part on the ray, so only the reduced extinction removes it.
+  const Rgb T_end = s_.light_side() ? cam.T_full : cam.T_red;
   const GatherFn gather = [&](const Ray& r) { return trace(r, rng, nullptr, bounces - 1); };
-  return L + ray_end_radiance(ctx_, on_surface ? &hit : nullptr, s_.light_side() ? cam.T_full : cam.T_red,
-                              rng, sample, bounces > 0 ? &gather : nullptr);
+  Rgb surface_direct;
+  const Rgb L_end = ray_end_radiance(ctx_, on_surface ? &hit : nullptr, T_end, rng, sample,
+                                     bounces > 0 ? &gather : nullptr, &surface_direct);
+  layers.finish(ctx_, on_surface ? Rgb(0.0) : T_end, direct + surface_direct);
+  return L + L_end;
 }
 
 MfsIntegrator::MediumRadiance MfsIntegrator::medium_radiance(int i, const Vec3& p, const Vec3& d, double t,
@@ -186,7 +199,7 @@ MfsIntegrator::MediumRadiance MfsIntegrator::medium_radiance(int i, const Vec3& 
                                                              Rng& rng) const {
   const PhaseSplit& split = *splits_[i];
   const double f = f_[i];
-  MediumRadiance out{Rgb(0.0), Rgb(0.0)};
+  MediumRadiance out{Rgb(0.0), Rgb(0.0), Rgb(0.0)};
   // Sample every light once (u1, u2, in this order) and add its first wide scatter and forward peak.
   for (size_t l = 0; l < ctx_.lights.size(); ++l) {
     LightSample ls;
@@ -208,6 +221,7 @@ MfsIntegrator::MediumRadiance MfsIntegrator::medium_radiance(int i, const Vec3& 
       out.L += forward_peak(ls.weight, f, split, mu, y.tau_p, beam.T_light);
   }
   // Add the light that already took wide scatters (and the environment's): its last wide scatter is at y.
+  out.L_lights = out.L;
   if (grid_) out.L += higher_orders(i, p, d, t, y.tau_p, cam);
   return out;
 }

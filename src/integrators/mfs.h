@@ -123,8 +123,9 @@ class MfsIntegrator final : public Integrator {
 
   // The parts of `Li` (mfs.cpp); the physics is in mfs_estimators.h.
   struct MediumRadiance {
-    Rgb L;       // per unit sigma_s_i, reaching the camera through CameraPoint::T_cam
-    Rgb L_peak;  // the forward-peak-only paths (light_path "forward"), through CameraPoint::T_full
+    Rgb L;         // per unit sigma_s_i, reaching the camera through CameraPoint::T_cam
+    Rgb L_peak;    // the forward-peak-only paths (light_path "forward"), through CameraPoint::T_full
+    Rgb L_lights;  // the part of L straight from the lights (no scatter grid): the `direct` layer
   };
   // What medium i sends towards the camera from the sample point p (at distance t) of the march: one
   // sample of every light (eqs. D7, D11) and the scatter grid's higher orders (eq. D12).

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "core/json_reader.h"
+#include "integrators/camera_layers.h"
 #include "integrators/surface_light.h"
 #include "integrators/tracking.h"
 #include "media/phase.h"
@@ -107,15 +108,17 @@ Rgb OctaveIntegrator::trace(const Ray& ray, Rng& rng, CameraSample* sample, int 
     bj[j] = std::pow(s_.b, j);
   }
   // Camera-side optical depth from the camera (octave j sees exp(-b^j tau)).
-  Rgb L(0.0), tau(0.0);
+  Rgb L(0.0), tau(0.0), direct(0.0);  // direct: octave 0, the exact single scattering
+  MarchRecorder layers(sample);
   const double jitter = rng.uniform();
   MediumPoint mp;
   LightSamples lights;
   lights.ls.resize(ctx_.lights.size());
   lights.T.resize(ctx_.lights.size());
   lights.ok.resize(ctx_.lights.size());
-  march(ctx_.majorants, o, d, hit.t, s_.tau_step, jitter, [&](const Vec3& p, double, double dt) {
+  march(ctx_.majorants, o, d, hit.t, s_.tau_step, jitter, [&](const Vec3& p, double t, double dt) {
     ctx_.media.eval(p, &mp);
+    Rgb L_step(0.0);
     if (max_component(mp.sigma_s) > 0.0) {
       const Rgb tau_here = tau + mp.sigma_t() * (jitter * dt);
       // Light transmittance exp(-tau_l) once per light (octave j: raised to b^j).
@@ -123,7 +126,7 @@ Rgb OctaveIntegrator::trace(const Ray& ray, Rng& rng, CameraSample* sample, int 
         const double u1 = rng.uniform(), u2 = rng.uniform();
         lights.ok[l] = sample_light(ctx_.lights[l], p, u1, u2, &lights.ls[l]);
         if (lights.ok[l] && ctx_.surfaces.occluded(p, lights.ls[l].wi, lights.ls[l].distance))
-          lights.ok[l] = false;
+          lights.ok[l] = false;  // a surface shadows p
         if (lights.ok[l]) lights.T[l] = maps_[l].lookup(p);
       }
       // Octave j: scattering a^j sigma_s seen through the camera-side transmittance exp(-b^j tau).
@@ -131,16 +134,24 @@ Rgb OctaveIntegrator::trace(const Ray& ray, Rng& rng, CameraSample* sample, int 
         Rgb Tc;
         for (int c = 0; c < 3; ++c) Tc[c] = std::exp(-bj[j] * tau_here[c]);
         if (max_component(Tc) < 1e-7) continue;
-        L += Tc * octave_scatter(j, bj[j], p, d, mp, lights, rng) * (aj[j] * dt);
+        const Rgb Lj = Tc * octave_scatter(j, bj[j], p, d, mp, lights, rng) * (aj[j] * dt);
+        L += Lj;
+        L_step += Lj;
+        if (j == 0) direct += Lj;
       }
     }
+    const Rgb T0 = exp(-tau);
     tau += mp.sigma_t() * dt;
+    layers.step(t - jitter * dt, dt, T0, exp(-tau), mp, L_step);
     return min_component(tau) * bj[N - 1] < 14.0;
   });
   // The surface the ray ends on (lit directly and by one gathered ray) or the environment.
   const GatherFn gather = [&](const Ray& r) { return trace(r, rng, nullptr, bounces - 1); };
-  return L + ray_end_radiance(ctx_, on_surface ? &hit : nullptr, exp(-tau), rng, sample,
-                              bounces > 0 ? &gather : nullptr);
+  Rgb surface_direct;
+  const Rgb L_end = ray_end_radiance(ctx_, on_surface ? &hit : nullptr, exp(-tau), rng, sample,
+                                     bounces > 0 ? &gather : nullptr, &surface_direct);
+  layers.finish(ctx_, on_surface ? Rgb(0.0) : exp(-tau), direct + surface_direct);
+  return L + L_end;
 }
 
 }  // namespace nimbus

@@ -1,11 +1,71 @@
 #include "integrators/pathtrace.h"
 
 #include "core/json_reader.h"
+#include "integrators/camera_layers.h"
 #include "integrators/surface_light.h"
 #include "integrators/tracking.h"
 #include "scene/lights.h"
 
 namespace nimbus {
+
+namespace {
+
+// The depth march's step in optical depth against the majorant (deterministic: no random numbers).
+constexpr double kDepthTauStep = 0.02;
+
+// What the camera ray's first flight tells the layers (with a CameraSample): whether it escaped and with
+// which weight (an unbiased estimate of the transmittance, from the same random numbers as the beauty),
+// where it ended, where its null collisions lay (the transmittance an escaping weight lost), and the NEE
+// at its first scattering vertex.
+struct FirstFlight {
+  const Ray& ray;
+  bool active = false, escaped = false, on_surface = false;
+  int hit_surface = -1;
+  Rgb weight{0.0}, direct{0.0};
+  double t_end = 0.0, t_null0 = std::numeric_limits<double>::infinity(), t_null1 = -1.0;
+
+  bool null_collision(int events, const Vec3& p) {  // returns true: tracking goes on
+    if (active && events == 0) {
+      const double t = dot(p - ray.o, ray.d);
+      t_null0 = std::min(t_null0, t);
+      t_null1 = std::max(t_null1, t);
+    }
+    return true;
+  }
+  void end(bool did_escape, const Rgb& beta, const Vec3& p) {
+    escaped = did_escape;
+    weight = beta;
+    if (!did_escape) t_end = dot(p - ray.o, ray.d);
+  }
+  void end_on_surface(const SurfaceHit& hit, const Rgb& beta) {
+    on_surface = true;
+    hit_surface = hit.surface;
+    weight = beta;
+    t_end = hit.t;
+  }
+};
+
+// The layers of one camera sample: escape transmittance 1 x weight or 0, direct = background + the first
+// NEE (or the first surface's light), depth and albedo by a deterministic march up to the first surface,
+// and one deep segment (the whole radiance at the first collision, alpha 1; or an escape's lost alpha
+// over its null collisions). A surface's own layers (record_surface_hit) were written when it was met.
+void fill_camera_sample(const SceneContext& ctx, const FirstFlight& f, const Rgb& L, CameraSample* s) {
+  s->escape_transmittance = f.escaped ? f.weight : Rgb(0.0);
+  s->background = f.escaped && ctx.has_environment ? f.weight * ctx.environment : Rgb(0.0);
+  s->direct = s->background + f.direct;
+  if (s->depth_wanted) march_depth(ctx.media, ctx.majorants, f.ray.o, f.ray.d, kDepthTauStep, s, s->depth);
+  if (!s->deep) return;
+  // A holdout cuts out what lies behind it, like the background: only the media in front of it remain.
+  const bool holdout =
+      f.on_surface && !std::holds_alternative<DiffuseMaterial>(ctx.surfaces.material(f.hit_surface));
+  if (!f.escaped && !holdout) {
+    s->deep->push_back({f.t_end, f.t_end, L - s->background, 1.0});
+  } else if (f.t_null1 >= f.t_null0 && average(f.weight) != 1.0) {
+    s->deep->push_back({f.t_null0, f.t_null1, L - s->background, 1.0 - average(f.weight)});
+  }
+}
+
+}  // namespace
 
 PathTraceSettings pathtrace_settings_from_json(const nlohmann::json& options, const std::string& where) {
   PathTraceSettings s;
@@ -104,6 +164,7 @@ Rgb PathTracer::Li(const Ray& ray, Rng& rng, CameraSample* sample) const {
   Vec3 o = ray.o, d = ray.d;
   int wide = 0;  // wide scatters so far (with a wide-scatter limit)
   MediumPoint mp;
+  FirstFlight first{ray, sample != nullptr};
   for (int events = 0;; ++events) {
     // The free flight ends at the first surface, if any.
     SurfaceHit hit;
@@ -113,25 +174,34 @@ Rgb PathTracer::Li(const Ray& ray, Rng& rng, CameraSample* sample) const {
     Vec3 scatter_p;
     const bool escaped = track(ctx_.majorants, o, d, hit.t, rng, [&](const Vec3& p, double maj) {
       ctx_.media.eval(p, &mp);
-      if (!collide(mp, maj, beta, rng, &scatter_medium)) return true;
+      if (!collide(mp, maj, beta, rng, &scatter_medium)) return first.null_collision(events, p);
       scatter_p = p;
       return false;
     });
     if (escaped && to_surface) {
-      if (events == 0 && sample) record_surface_hit(ctx_, hit, beta, sample);
-      if (!reflect(hit, L, beta, wide, rng)) break;
-      if (max_events_ > 0 && events + 1 >= max_events_) break;
+      if (events == 0 && sample) {
+        first.end_on_surface(hit, beta);
+        record_surface_hit(ctx_, hit, beta, sample);
+      }
+      const Rgb L_before = L;
+      const bool goes_on = reflect(hit, L, beta, wide, rng);
+      if (events == 0) first.direct = L - L_before;
+      if (!goes_on || (max_events_ > 0 && events + 1 >= max_events_)) break;
       d = cosine_direction(hit.ns, rng.uniform(), rng.uniform());
       if (dot(d, hit.ng) <= 0.0) break;  // below the geometric surface (shading normals): absorbed
       o = SceneSurfaces::offset(hit.p, hit.ng, d);
     } else if (escaped) {
+      if (events == 0) first.end(true, beta, scatter_p);
       // Only camera rays see the environment directly; later escapes were counted by NEE.
       if (events == 0 && ctx_.has_environment) L += beta * ctx_.environment;
       break;
     } else {
+      if (events == 0) first.end(false, beta, scatter_p);
       if (scatter_medium < 0 || max_component(beta) <= 0.0) break;
       // Next-event estimation at the scattering vertex.
-      L += beta * direct_light(scatter_p, d, scatter_medium, wide, rng);
+      const Rgb L_direct = beta * direct_light(scatter_p, d, scatter_medium, wide, rng);
+      L += L_direct;
+      if (events == 0) first.direct = L_direct;
       if (max_events_ > 0 && events + 1 >= max_events_) break;
       if (!scatter(scatter_medium, d, wide, rng)) break;
       o = scatter_p;
@@ -144,6 +214,7 @@ Rgb PathTracer::Li(const Ray& ray, Rng& rng, CameraSample* sample) const {
       beta /= q;
     }
   }
+  if (sample) fill_camera_sample(ctx_, first, L, sample);
   return L;
 }
 

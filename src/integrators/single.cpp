@@ -1,6 +1,7 @@
 #include "integrators/single.h"
 
 #include "core/json_reader.h"
+#include "integrators/camera_layers.h"
 #include "integrators/surface_light.h"
 #include "integrators/tracking.h"
 #include "media/phase.h"
@@ -55,9 +56,11 @@ Rgb SingleScatter::trace(const Ray& ray, Rng& rng, CameraSample* sample, int bou
   Rgb L(0.0), T(1.0);
   const double jitter = rng.uniform();
   MediumPoint mp;
-  march(ctx_.majorants, o, d, hit.t, s_.tau_step, jitter, [&](const Vec3& p, double, double dt) {
+  MarchRecorder layers(sample);  // depth, albedo and deep segments when the film asks
+  march(ctx_.majorants, o, d, hit.t, s_.tau_step, jitter, [&](const Vec3& p, double t, double dt) {
     ctx_.media.eval(p, &mp);
     const Rgb step_T = exp(-mp.sigma_t() * dt);
+    Rgb L_step(0.0);
     if (max_component(mp.sigma_s) > 0.0) {
       // Camera-side transmittance to the sample point, then single scattering towards the lights.
       const Rgb T_here = T * exp(-mp.sigma_t() * (jitter * dt));
@@ -84,16 +87,21 @@ Rgb SingleScatter::trace(const Ray& ray, Rng& rng, CameraSample* sample, int bou
         }
         in_scatter += mp.sigma_s_i[i] * Li / double(s_.light_samples);
       }
-      L += T_here * in_scatter * dt;
+      L_step = T_here * in_scatter * dt;
+      L += L_step;
     }
+    layers.step(t - jitter * dt, dt, T, T * step_T, mp, L_step);
     T *= step_T;
     return max_component(T) > 1e-6;
   });
   // The surface the ray ends on (lit directly, and by the light gathered along one more traced ray) or
-  // the environment.
+  // the environment. All of single's own light is direct; a surface's gathered light is not.
   const GatherFn gather = [&](const Ray& r) { return trace(r, rng, nullptr, bounces - 1); };
-  return L +
-         ray_end_radiance(ctx_, on_surface ? &hit : nullptr, T, rng, sample, bounces > 0 ? &gather : nullptr);
+  Rgb surface_direct;
+  const Rgb L_end = ray_end_radiance(ctx_, on_surface ? &hit : nullptr, T, rng, sample,
+                                     bounces > 0 ? &gather : nullptr, &surface_direct);
+  layers.finish(ctx_, on_surface ? Rgb(0.0) : T, L + surface_direct);
+  return L + L_end;
 }
 
 }  // namespace nimbus

@@ -25,10 +25,12 @@ Rgb surface_direct_light(const SceneContext& ctx, const SurfaceHit& hit, const R
   return albedo * E;
 }
 
-Rgb surface_radiance(const SceneContext& ctx, const SurfaceHit& hit, Rng& rng, const GatherFn* gather) {
+Rgb surface_radiance(const SceneContext& ctx, const SurfaceHit& hit, Rng& rng, const GatherFn* gather,
+                     Rgb* direct_part) {
   const auto* diffuse = std::get_if<DiffuseMaterial>(&ctx.surfaces.material(hit.surface));
   if (!diffuse) return Rgb(0.0);  // a holdout
   Rgb L = surface_direct_light(ctx, hit, diffuse->albedo, rng);
+  if (direct_part) *direct_part = L;
   if (!gather && !ctx.has_environment) return L;
   const double u1 = rng.uniform(), u2 = rng.uniform();
   const Vec3 wi = cosine_direction(hit.ns, u1, u2);
@@ -40,22 +42,27 @@ Rgb surface_radiance(const SceneContext& ctx, const SurfaceHit& hit, Rng& rng, c
 }
 
 Rgb ray_end_radiance(const SceneContext& ctx, const SurfaceHit* hit, const Rgb& T, Rng& rng,
-                     CameraSample* sample, const GatherFn* gather) {
+                     CameraSample* sample, const GatherFn* gather, Rgb* direct_part) {
+  if (direct_part) *direct_part = Rgb(0.0);
   if (!hit) return ctx.has_environment ? T * ctx.environment : Rgb(0.0);
   if (sample) record_surface_hit(ctx, *hit, T, sample);
   if (max_component(T) <= 0.0) return Rgb(0.0);
-  return T * surface_radiance(ctx, *hit, rng, gather);
+  Rgb direct(0.0);
+  const Rgb L = T * surface_radiance(ctx, *hit, rng, gather, &direct);
+  if (direct_part) *direct_part = T * direct;
+  const bool diffuse = std::holds_alternative<DiffuseMaterial>(ctx.surfaces.material(hit->surface));
+  if (sample && sample->deep && diffuse) sample->deep->push_back({hit->t, hit->t, L, average(T)});
+  return L;
 }
 
 void record_surface_hit(const SceneContext& ctx, const SurfaceHit& hit, const Rgb& T, CameraSample* sample) {
   sample->escape_transmittance = Rgb(0.0);
-  sample->depth = hit.t;
   sample->normal = hit.ns;
-  if (const auto* diffuse = std::get_if<DiffuseMaterial>(&ctx.surfaces.material(hit.surface))) {
-    sample->albedo = diffuse->albedo;
-  } else {
-    sample->holdout_transmittance = T;
-  }
+  const auto* diffuse = std::get_if<DiffuseMaterial>(&ctx.surfaces.material(hit.surface));
+  if (!diffuse) sample->holdout_transmittance = T;
+  if (std::isfinite(sample->depth)) return;  // the media in front hold the depth
+  sample->depth = hit.t;
+  sample->albedo = diffuse ? diffuse->albedo : Rgb(0.0);
 }
 
 }  // namespace nimbus

@@ -25,15 +25,20 @@ Rgb surface_direct_light(const SceneContext& ctx, const SurfaceHit& hit, const R
 // medium's scattered light, the environment and surfaces behind, with their direct light); without a
 // gather (nullptr), only the environment through the media is gathered.
 using GatherFn = std::function<Rgb(const Ray&)>;
-Rgb surface_radiance(const SceneContext& ctx, const SurfaceHit& hit, Rng& rng, const GatherFn* gather);
+// *direct_part (when given) receives the lights' direct part of the result.
+Rgb surface_radiance(const SceneContext& ctx, const SurfaceHit& hit, Rng& rng, const GatherFn* gather,
+                     Rgb* direct_part = nullptr);
 
 // The light at the end of a marched ray, seen through its transmittance T: the surface it ends on (hit,
-// through surface_radiance with `gather`; its layers recorded into a non-null sample), or with
-// hit == nullptr the environment.
+// through surface_radiance with `gather`; its layers recorded into a non-null sample, with a deep
+// segment for a diffuse surface), or with hit == nullptr the environment. *direct_part (when given)
+// receives the surface's direct light as seen through T (0 for the environment).
 Rgb ray_end_radiance(const SceneContext& ctx, const SurfaceHit* hit, const Rgb& T, Rng& rng,
-                     CameraSample* sample, const GatherFn* gather);
+                     CameraSample* sample, const GatherFn* gather, Rgb* direct_part = nullptr);
 
-// The compositing layers of a camera ray ending on a surface, seen through transmittance T.
+// The compositing layers of a camera ray ending on a surface, seen through transmittance T: no escape,
+// the holdout's transmittance, the shading normal, and depth and albedo unless the media in front
+// already set them (their transmittance fell to one half before the surface).
 void record_surface_hit(const SceneContext& ctx, const SurfaceHit& hit, const Rgb& T, CameraSample* sample);
 
 }  // namespace nimbus

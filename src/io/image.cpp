@@ -1,4 +1,5 @@
-// Image files (nimbus/image.h): EXR read and write, sRGB PNG output, both written atomically.
+// Image files (nimbus/image.h): EXR read and write (RGB, alpha, layers), sRGB PNG output, both written
+// atomically. Deep EXR: io/deep_exr.cpp.
 #include "nimbus/image.h"
 
 #include <OpenEXR/ImfChannelList.h>
@@ -10,6 +11,7 @@
 #include <fmt/format.h>
 #include <png.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "io/atomic_file.h"
@@ -31,12 +33,20 @@ double srgb_encode(double x) {
 }
 
 void write_exr(const fs::path& path, const Image& img, const ImageMetadata& meta) {
-  if (img.width <= 0 || img.height <= 0 || img.rgb.size() != size_t(img.width) * img.height * 3)
+  const size_t n = size_t(std::max(img.width, 0)) * size_t(std::max(img.height, 0));
+  if (img.width <= 0 || img.height <= 0 || img.rgb.size() != n * 3 ||
+      (!img.alpha.empty() && img.alpha.size() != n))
     throw Error(fmt::format("{}: cannot write an empty or malformed image", path.string()));
+  for (const ImageChannel& c : img.channels)
+    if (c.data.size() != n || c.name.empty() || c.name == "R" || c.name == "G" || c.name == "B" ||
+        c.name == "A")
+      throw Error(fmt::format("{}: malformed image channel '{}'", path.string(), c.name));
   atomic_write(path, [&](const fs::path& tmp) {
     Imf::Header header(img.width, img.height);
     header.compression() = Imf::ZIP_COMPRESSION;
     for (const char* c : {"R", "G", "B"}) header.channels().insert(c, Imf::Channel(Imf::FLOAT));
+    if (!img.alpha.empty()) header.channels().insert("A", Imf::Channel(Imf::FLOAT));
+    for (const ImageChannel& c : img.channels) header.channels().insert(c.name, Imf::Channel(Imf::FLOAT));
     for (const auto& [key, value] : meta) header.insert(key, Imf::StringAttribute(value));
     Imf::OutputFile file(tmp.c_str(), header);
     Imf::FrameBuffer fb;
@@ -45,6 +55,12 @@ void write_exr(const fs::path& path, const Image& img, const ImageMetadata& meta
     fb.insert("R", Imf::Slice(Imf::FLOAT, base, xs, ys));
     fb.insert("G", Imf::Slice(Imf::FLOAT, base + sizeof(float), xs, ys));
     fb.insert("B", Imf::Slice(Imf::FLOAT, base + 2 * sizeof(float), xs, ys));
+    auto plane = [&](const std::string& name, const std::vector<float>& data) {
+      char* p = reinterpret_cast<char*>(const_cast<float*>(data.data()));
+      fb.insert(name, Imf::Slice(Imf::FLOAT, p, sizeof(float), sizeof(float) * img.width));
+    };
+    if (!img.alpha.empty()) plane("A", img.alpha);
+    for (const ImageChannel& c : img.channels) plane(c.name, c.data);
     file.setFrameBuffer(fb);
     file.writePixels(img.height);
   });
@@ -67,6 +83,12 @@ Image read_exr(const fs::path& path, ImageMetadata* meta) {
     fb.insert("R", Imf::Slice(Imf::FLOAT, base, xs, ys, 1, 1, 0.0));
     fb.insert("G", Imf::Slice(Imf::FLOAT, base + sizeof(float), xs, ys, 1, 1, 0.0));
     fb.insert("B", Imf::Slice(Imf::FLOAT, base + 2 * sizeof(float), xs, ys, 1, 1, 0.0));
+    if (channels.findChannel("A")) {
+      img.alpha.assign(size_t(w) * h, 1.0f);
+      char* a = reinterpret_cast<char*>(img.alpha.data()) -
+                (size_t(dw.min.x) * sizeof(float) + size_t(dw.min.y) * sizeof(float) * w);
+      fb.insert("A", Imf::Slice(Imf::FLOAT, a, sizeof(float), sizeof(float) * w, 1, 1, 1.0));
+    }
     file.setFrameBuffer(fb);
     file.readPixels(dw.min.y, dw.max.y);
     if (meta) {

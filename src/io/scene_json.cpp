@@ -164,6 +164,28 @@ IntegratorSettings parse_integrator(const nlohmann::json& j, JsonObject o) {
   return s;
 }
 
+FilmSettings parse_film(JsonObject o) {
+  FilmSettings f;
+  f.transparent = o.boolean("transparent", f.transparent);
+  if (o.has("layers")) {
+    const nlohmann::json& layers = o.raw("layers");
+    if (!layers.is_array()) o.fail("layers", "must be an array of layer names");
+    const std::vector<std::string>& known = film_layer_names();
+    for (size_t i = 0; i < layers.size(); ++i) {
+      const std::string key = fmt::format("layers/{}", i);
+      if (!layers[i].is_string()) o.fail(key, "must be a layer name (a string)");
+      const std::string name = layers[i].get<std::string>();
+      if (std::find(known.begin(), known.end(), name) == known.end())
+        o.fail(key, fmt::format("unknown layer '{}' (known: {})", name, fmt::join(known, ", ")));
+      if (std::find(f.layers.begin(), f.layers.end(), name) != f.layers.end())
+        o.fail(key, fmt::format("layer '{}' named twice", name));
+      f.layers.push_back(name);
+    }
+  }
+  o.finish();
+  return f;
+}
+
 }  // namespace
 
 Scene parse_scene(const nlohmann::json& doc, const std::string& name, const std::filesystem::path& base_dir) {
@@ -181,6 +203,7 @@ Scene parse_scene(const nlohmann::json& doc, const std::string& name, const std:
   for (JsonObject& l : root.array_of_objects("lights", true)) scene.lights.push_back(parse_light(l));
   if (root.has("integrator"))
     scene.integrator = parse_integrator(doc["integrator"], root.object("integrator"));
+  if (root.has("film")) scene.film = parse_film(root.object("film"));
   root.finish();
   scene.source = doc;
   return scene;

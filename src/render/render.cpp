@@ -16,7 +16,9 @@
 
 #include "integrators/registry.h"
 #include "nimbus/error.h"
+#include "render/deep.h"
 #include "render/film.h"
+#include "render/film_layers.h"
 
 namespace nimbus {
 
@@ -40,6 +42,9 @@ IntegratorSettings resolve_settings(const Scene& scene, const RenderOptions& opt
     throw Error(fmt::format("spp must be between 1 and {}", kMaxSpp));
   if (options.threads < 0) throw Error("threads must be >= 0");
   if (options.tile_size < 1) throw Error("tile size must be >= 1");
+  if (options.layers) check_film_layers(*options.layers);  // before any precomputation
+  if (options.deep_samples < 0 || options.deep_samples > kMaxDeepSamples)
+    throw Error(fmt::format("deep samples must be between 1 and {} (0: no deep image)", kMaxDeepSamples));
   return settings;
 }
 
@@ -54,23 +59,62 @@ nlohmann::json resolved_block(const IntegratorSettings& settings, const Integrat
   return block;
 }
 
+// What the film needs of every camera sample: its layers and, for a deep image, the pixel's segments
+// (reused from pixel to pixel by one thread) and where its deep samples go.
+struct PixelTargets {
+  Film& film;
+  const FilmLayers& layers;
+  int deep_samples = 0;                               // 0: no deep image
+  std::vector<std::vector<DeepSample>>* deep_pixels;  // per pixel, when deep_samples > 0
+};
+
 // Samples of pixel (x, y) into the film. Positions in the pixel: the R2 sequence (Roberts 2018), shifted
 // by a random offset per pixel (a Cranley-Patterson rotation, so each sample is still uniform over the
 // pixel and the estimate unbiased); its samples are spread evenly for every spp, which halves edge noise
 // at a few spp. Returns the number of non-finite samples (dropped).
 int64_t render_pixel(const Integrator& integrator, const PinholeCamera& camera,
-                     const IntegratorSettings& settings, int x, int y, Film& film) {
+                     const IntegratorSettings& settings, int x, int y, const PixelTargets& to) {
   Rng shift = Rng::for_sample(settings.seed, uint32_t(x), uint32_t(y), ~uint64_t(0));
   const double ux = shift.uniform(), uy = shift.uniform();
   int64_t bad = 0;
+  thread_local std::vector<DeepSegment> segments, sample_segments;
+  segments.clear();
   for (int s = 0; s < settings.spp; ++s) {
     Rng rng = Rng::for_sample(settings.seed, uint32_t(x), uint32_t(y), uint64_t(s));
     double jx = ux + s * kR2a1, jy = uy + s * kR2a2;
     jx -= std::floor(jx);
     jy -= std::floor(jy);
-    if (!film.add_sample(x, y, integrator.Li(camera.generate_ray(x + jx, y + jy), rng))) ++bad;
+    CameraSample sample;
+    sample.depth_wanted = to.layers.depth_wanted();
+    sample_segments.clear();
+    if (to.deep_samples > 0) sample.deep = &sample_segments;
+    const Rgb L = integrator.Li(camera.generate_ray(x + jx, y + jy), rng, &sample);
+    if (!to.layers.add(to.film, x, y, L, sample)) {
+      ++bad;
+      continue;  // a dropped sample adds nothing to the deep pixel either
+    }
+    segments.insert(segments.end(), sample_segments.begin(), sample_segments.end());
+  }
+  if (to.deep_samples > 0) {
+    const size_t i = size_t(y) * size_t(to.film.width()) + size_t(x);
+    merge_deep_segments(segments, 1.0 / settings.spp, to.deep_samples, &(*to.deep_pixels)[i]);
   }
   return bad;
+}
+
+// The pixels' deep samples as one deep image.
+DeepImage assemble_deep(int width, int height, std::vector<std::vector<DeepSample>>& pixels) {
+  DeepImage deep;
+  deep.width = width;
+  deep.height = height;
+  deep.offsets.assign(pixels.size() + 1, 0);
+  for (size_t i = 0; i < pixels.size(); ++i) deep.offsets[i + 1] = deep.offsets[i] + pixels[i].size();
+  deep.samples.reserve(deep.offsets.back());
+  for (auto& p : pixels) {
+    deep.samples.insert(deep.samples.end(), p.begin(), p.end());
+    std::vector<DeepSample>().swap(p);
+  }
+  return deep;
 }
 
 }  // namespace
@@ -96,6 +140,11 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
   result.seed = settings.seed;
   const int W = scene.camera.width, H = scene.camera.height, ts = options.tile_size;
   Film film(W, H);
+  FilmSettings film_settings = scene.film;
+  if (options.layers) film_settings.layers = *options.layers;
+  const FilmLayers layers(film, film_settings, context->has_environment);
+  std::vector<std::vector<DeepSample>> deep_pixels(options.deep_samples > 0 ? size_t(W) * size_t(H) : 0);
+  const PixelTargets targets{film, layers, options.deep_samples, &deep_pixels};
   const int tiles_x = (W + ts - 1) / ts, tiles_y = (H + ts - 1) / ts;
   result.tiles_total = int64_t(tiles_x) * tiles_y;
 
@@ -113,7 +162,8 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
         nonfinite += bad;
         return;
       }
-      for (int x = x0; x < x1; ++x) bad += render_pixel(*integrator, context->camera, settings, x, y, film);
+      for (int x = x0; x < x1; ++x)
+        bad += render_pixel(*integrator, context->camera, settings, x, y, targets);
     }
     nonfinite += bad;
     const int64_t done = ++tiles_done;
@@ -128,7 +178,8 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
                       });
   });
 
-  result.image = film.resolve();
+  result.image = layers.resolve(film);
+  if (options.deep_samples > 0) result.deep = assemble_deep(W, H, deep_pixels);
   result.tiles_done = tiles_done;
   result.partial = stopped || tiles_done < result.tiles_total;
   result.nonfinite_samples = nonfinite;
@@ -138,6 +189,8 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
   result.settings = resolved_block(settings, *integrator);
   nlohmann::json rendered = scene.source.is_object() ? scene.source : nlohmann::json::object();
   rendered["integrator"] = result.settings;
+  if (film_settings.transparent || !film_settings.layers.empty() || rendered.contains("film"))
+    rendered["film"] = {{"transparent", film_settings.transparent}, {"layers", film_settings.layers}};
   result.metadata = {
       {"nimbus/version", "0.1.0"},
       {"nimbus/integrator", settings.type},
