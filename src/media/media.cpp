@@ -75,8 +75,16 @@ double SceneMedia::max_density(int i, const Bounds& box) const {
   if (!medium_bounds_[i].overlaps(box)) return 0.0;
   const Shape& s = media_[i].shape;
   const Transform& to_local = to_local_[i];
-  // The world box in local space: the bounds of its 8 corners (it holds the box's whole image).
-  const Bounds local = transform_bounds(to_local, box);
+  // The world box in local space: the bounds of its 8 corners (they hold the box's whole image), widened
+  // by far more than the rounding of the mapping so that a point on the box's edge stays inside.
+  Bounds local = transform_bounds(to_local, box);
+  if (!to_local.is_identity()) {
+    for (int a = 0; a < 3; ++a) {
+      const double pad = 1e-9 * (std::abs(local.lo[a]) + std::abs(local.hi[a]));
+      local.lo[a] -= pad;
+      local.hi[a] += pad;
+    }
+  }
   if (const auto* sp = std::get_if<SphereShape>(&s)) {
     double d2 = 0.0;  // squared distance from the centre to the box
     for (int a = 0; a < 3; ++a) {
