@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "nimbus/phase.h"
+#include "nimbus/transform.h"
 #include "nimbus/types.h"
 
 namespace nimbus {
@@ -36,7 +37,7 @@ struct BoxShape {
   Vec3 min{-1, -1, -1}, max{1, 1, 1};
 };
 // A density grid from an OpenVDB/NanoVDB file: the file's own index-to-world transform, then
-// `scale`, then `translate`. The grid value multiplies sigma_s and sigma_a.
+// `scale`, then `translate` (then the medium's transform). The grid value multiplies sigma_s and sigma_a.
 struct VdbShape {
   std::string file;  // as written in the scene
   std::string grid;  // empty: the first float grid
@@ -56,6 +57,7 @@ using Shape = std::variant<SphereShape, BoxShape, VdbShape, CloudShape>;
 
 struct Medium {
   Shape shape;
+  Transform transform;   // world = transform(the shape's own placement); identity by default
   Rgb sigma_s{1, 1, 1};  // 1/length
   Rgb sigma_a{0, 0, 0};  // 1/length
   Phase phase = IsotropicPhase{};

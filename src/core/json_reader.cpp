@@ -75,6 +75,14 @@ double JsonObject::number_open_below(const std::string& key, double lo, double h
   return x;
 }
 
+double JsonObject::number_open_below(const std::string& key, double lo, double hi, double fallback) {
+  if (!has(key)) {
+    used_.insert(key);
+    return fallback;
+  }
+  return number_open_below(key, lo, hi);
+}
+
 int64_t JsonObject::integer(const std::string& key, int64_t lo, int64_t hi) {
   const nlohmann::json& v = field(key);
   const double x = check_number(v, path_of(key));

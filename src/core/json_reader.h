@@ -24,12 +24,18 @@ class JsonObject {
   const std::string& path() const { return path_; }
 
   bool has(const std::string& key) const { return j_.contains(key); }
+  // has(key), and the key counts as known either way (listed in unknown-field messages).
+  bool present(const std::string& key) {
+    used_.insert(key);
+    return has(key);
+  }
   const nlohmann::json& raw(const std::string& key);  // marks the key used; must exist
 
   // Numbers: finite, within [lo, hi] (inclusive unless the *_open variants).
   double number(const std::string& key, double lo, double hi);
   double number(const std::string& key, double lo, double hi, double fallback);
   double number_open_below(const std::string& key, double lo, double hi);  // lo < x <= hi
+  double number_open_below(const std::string& key, double lo, double hi, double fallback);
   int64_t integer(const std::string& key, int64_t lo, int64_t hi);
   int64_t integer(const std::string& key, int64_t lo, int64_t hi, int64_t fallback);
   std::optional<int64_t> optional_integer(const std::string& key, int64_t lo, int64_t hi);  // nullopt: absent

@@ -6,6 +6,7 @@
 #include <limits>
 #include <numbers>
 
+#include "nimbus/transform.h"
 #include "nimbus/types.h"
 
 namespace nimbus {
@@ -92,5 +93,20 @@ struct Bounds {
     return true;
   }
 };
+
+// The corners of the box [lo, hi] through any map f, and the bounds of their images: for an affine f the
+// image of the box is the parallelepiped these 8 points span, so the bounds are exact and conservative.
+template <typename F>
+Bounds bounds_of_mapped_box(const Vec3& lo, const Vec3& hi, F&& f) {
+  Bounds b;
+  for (int k = 0; k < 8; ++k)
+    b.extend(f(Vec3(k & 1 ? hi.x : lo.x, k & 2 ? hi.y : lo.y, k & 4 ? hi.z : lo.z)));
+  return b;
+}
+// World bounds of a local box under a transform (empty stays empty).
+inline Bounds transform_bounds(const Transform& t, const Bounds& b) {
+  if (b.empty() || t.is_identity()) return b;
+  return bounds_of_mapped_box(b.lo, b.hi, [&](const Vec3& p) { return t.point(p); });
+}
 
 }  // namespace nimbus

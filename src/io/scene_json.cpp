@@ -9,6 +9,7 @@
 #include "integrators/registry.h"
 #include "io/scene_surfaces.h"
 #include "io/scene_volumes.h"
+#include "io/transform_json.h"
 #include "media/media.h"
 #include "media/phase.h"
 #include "nimbus/error.h"
@@ -74,7 +75,7 @@ Shape parse_shape(JsonObject o, const std::filesystem::path& base_dir) {
     v.file = o.string("file");
     v.grid = o.string("grid", "");
     v.translate = o.vec3("translate", v.translate);
-    v.scale = o.number_open_below("scale", 0.0, 1e30);
+    v.scale = o.number_open_below("scale", 0.0, 1e30, v.scale);
     load_vdb_shape(v, base_dir, o.where(), o.path());
     shape = v;
   } else if (type == "cloud") {
@@ -95,6 +96,7 @@ Shape parse_shape(JsonObject o, const std::filesystem::path& base_dir) {
 Medium parse_medium(JsonObject o, const std::filesystem::path& base_dir) {
   Medium m;
   m.shape = parse_shape(o.object("shape"), base_dir);
+  m.transform = parse_optional_transform(o);
   m.sigma_s = o.rgb("sigma_s", 0.0);
   m.sigma_a = o.rgb("sigma_a", 0.0, Rgb(0.0));
   m.phase = o.has("phase") ? parse_phase(o.object("phase")) : Phase{IsotropicPhase{}};

@@ -8,7 +8,8 @@ namespace nimbus {
 
 namespace {
 
-// Smallest voxel edge (world units) of the grid media, 0 when there are none.
+// Smallest voxel edge (world units) of the grid media, 0 when there are none. (Without a transform the
+// x edge stands for all three, as it always has; with one, the shortest of the three transformed edges.)
 double finest_voxel(const SceneMedia& media) {
   double best = 0.0;
   for (int i = 0; i < media.count(); ++i) {
@@ -22,7 +23,17 @@ double finest_voxel(const SceneMedia& media) {
       g = c->data.get();
     }
     if (!g) continue;
-    const double voxel = length(g->index_to_world(Vec3(1, 0, 0)) - g->index_to_world(Vec3(0, 0, 0))) * scale;
+    const Transform& t = media.medium(i).transform;
+    double voxel = length(g->index_to_world(Vec3(1, 0, 0)) - g->index_to_world(Vec3(0, 0, 0))) * scale;
+    if (!t.is_identity()) {  // the shortest voxel edge once transformed (a non-uniform scale differs per axis)
+      voxel = std::numeric_limits<double>::infinity();
+      for (int a = 0; a < 3; ++a) {
+        Vec3 e(0.0);
+        e[a] = 1.0;
+        voxel =
+            std::min(voxel, length(t.vector((g->index_to_world(e) - g->index_to_world(Vec3(0.0))) * scale)));
+      }
+    }
     if (voxel > 0.0 && (best == 0.0 || voxel < best)) best = voxel;
   }
   return best;

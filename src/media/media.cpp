@@ -18,13 +18,33 @@ const DensityGrid* grid_of(const Shape& s) {
   return nullptr;
 }
 
-// World bounds of the index-space box [lo, hi] of a grid seen through an affine map f.
-template <typename F>
-Bounds transform_box(const Vec3& lo, const Vec3& hi, F&& f) {
-  Bounds b;
-  for (int k = 0; k < 8; ++k)
-    b.extend(f(Vec3(k & 1 ? hi.x : lo.x, k & 2 ? hi.y : lo.y, k & 4 ? hi.z : lo.z)));
-  return b;
+// Index-space point of a grid shape at a local (shape-space) point.
+Vec3 grid_index(const Shape& s, const DensityGrid& g, const Vec3& local) {
+  const auto* v = std::get_if<VdbShape>(&s);
+  return g.world_to_index(v ? vdb_grid_world(*v, local) : local);
+}
+
+// World bounds of medium m: its shape's local bounds through its transform. Analytic shapes are mapped
+// exactly (a sphere's image is an ellipsoid: half-extent r |row a of M| along world axis a), grid shapes
+// by the 8 corners of their index box through the whole chain index -> grid world -> local -> world.
+Bounds world_bounds(const Medium& m) {
+  const Transform& t = m.transform;
+  if (const auto* s = std::get_if<SphereShape>(&m.shape)) {
+    if (t.is_identity()) return Bounds{s->center - Vec3(s->radius), s->center + Vec3(s->radius)};
+    const Vec3 c = t.point(s->center);
+    const auto& a = t.matrix();
+    Vec3 half;
+    for (int r = 0; r < 3; ++r)
+      half[r] = s->radius * std::sqrt(a[r][0] * a[r][0] + a[r][1] * a[r][1] + a[r][2] * a[r][2]);
+    return Bounds{c - half, c + half};
+  }
+  if (const auto* x = std::get_if<BoxShape>(&m.shape)) return transform_bounds(t, Bounds{x->min, x->max});
+  const DensityGrid& g = *grid_of(m.shape);
+  const auto* v = std::get_if<VdbShape>(&m.shape);
+  return bounds_of_mapped_box(g.index_lo(), g.index_hi(), [&](const Vec3& i) {
+    const Vec3 local = v ? g.index_to_world(i) * v->scale + v->translate : g.index_to_world(i);
+    return t.is_identity() ? local : t.point(local);
+  });
 }
 
 }  // namespace
@@ -33,54 +53,53 @@ SceneMedia::SceneMedia(const std::vector<Medium>& media) : media_(media) {
   if (media_.size() > size_t(kMaxMedia))
     throw Error(fmt::format("too many media: {} (at most {})", media_.size(), kMaxMedia));
   for (const Medium& m : media_) {
-    Bounds b;
-    if (const auto* s = std::get_if<SphereShape>(&m.shape)) {
-      b.extend(s->center - Vec3(s->radius));
-      b.extend(s->center + Vec3(s->radius));
-    } else if (const auto* x = std::get_if<BoxShape>(&m.shape)) {
-      b.extend(x->min);
-      b.extend(x->max);
-    } else if (const auto* v = std::get_if<VdbShape>(&m.shape)) {
-      const DensityGrid& g = *v->data;
-      b = transform_box(g.index_lo(), g.index_hi(),
-                        [&](const Vec3& i) { return g.index_to_world(i) * v->scale + v->translate; });
-    } else if (const auto* c = std::get_if<CloudShape>(&m.shape)) {
-      const DensityGrid& g = *c->data;
-      b = transform_box(g.index_lo(), g.index_hi(), [&](const Vec3& i) { return g.index_to_world(i); });
-    }
-    medium_bounds_.push_back(b);
-    bounds_.extend(b);
+    medium_bounds_.push_back(world_bounds(m));
+    bounds_.extend(medium_bounds_.back());
+    to_local_.push_back(m.transform.inverse());
   }
 }
 
 double SceneMedia::density(int i, const Vec3& p) const {
-  const Shape& s = media_[i].shape;
   if (!medium_bounds_[i].contains(p)) return 0.0;
+  const Shape& s = media_[i].shape;
+  const bool identity = to_local_[i].is_identity();
+  const Vec3 q = identity ? p : to_local_[i].point(p);  // local (shape-space) point
   if (const auto* sp = std::get_if<SphereShape>(&s))
-    return (p - sp->center).length2() <= sp->radius * sp->radius;
-  if (std::holds_alternative<BoxShape>(s)) return 1.0;
-  if (const auto* v = std::get_if<VdbShape>(&s))
-    return v->data->density_index(v->data->world_to_index(vdb_grid_world(*v, p)));
+    return (q - sp->center).length2() <= sp->radius * sp->radius;
+  if (const auto* b = std::get_if<BoxShape>(&s)) return identity || Bounds{b->min, b->max}.contains(q);
   const DensityGrid* g = grid_of(s);
-  return g->density_index(g->world_to_index(p));
+  return g->density_index(grid_index(s, *g, q));
 }
 
 double SceneMedia::max_density(int i, const Bounds& box) const {
   if (!medium_bounds_[i].overlaps(box)) return 0.0;
   const Shape& s = media_[i].shape;
+  const Transform& to_local = to_local_[i];
+  // The world box in local space: the bounds of its 8 corners (they hold the box's whole image), widened
+  // by far more than the rounding of the mapping so that a point on the box's edge stays inside.
+  Bounds local = transform_bounds(to_local, box);
+  if (!to_local.is_identity()) {
+    for (int a = 0; a < 3; ++a) {
+      const double pad = 1e-9 * (std::abs(local.lo[a]) + std::abs(local.hi[a]));
+      local.lo[a] -= pad;
+      local.hi[a] += pad;
+    }
+  }
   if (const auto* sp = std::get_if<SphereShape>(&s)) {
     double d2 = 0.0;  // squared distance from the centre to the box
     for (int a = 0; a < 3; ++a) {
-      const double c = std::clamp(sp->center[a], box.lo[a], box.hi[a]) - sp->center[a];
+      const double c = std::clamp(sp->center[a], local.lo[a], local.hi[a]) - sp->center[a];
       d2 += c * c;
     }
     return d2 <= sp->radius * sp->radius ? 1.0 : 0.0;
   }
-  if (std::holds_alternative<BoxShape>(s)) return 1.0;
+  if (const auto* b = std::get_if<BoxShape>(&s))
+    return to_local.is_identity() || Bounds{b->min, b->max}.overlaps(local) ? 1.0 : 0.0;
+  // Grids: the world box's corners through the whole chain world -> local -> index (one affine map).
   const DensityGrid* g = grid_of(s);
-  const auto* v = std::get_if<VdbShape>(&s);
-  const Bounds ib = transform_box(
-      box.lo, box.hi, [&](const Vec3& p) { return g->world_to_index(v ? vdb_grid_world(*v, p) : p); });
+  const Bounds ib = bounds_of_mapped_box(box.lo, box.hi, [&](const Vec3& p) {
+    return grid_index(s, *g, to_local.is_identity() ? p : to_local.point(p));
+  });
   return g->max_density_index(ib.lo, ib.hi);
 }
 

@@ -31,7 +31,8 @@ class SceneMedia {
   const Bounds& bounds() const { return bounds_; }
   const Bounds& bounds(int i) const { return medium_bounds_[i]; }
 
-  // Shape density of medium i at world point p (1 inside analytic shapes, the grid value for grids).
+  // Shape density of medium i at world point p (1 inside analytic shapes, the grid value for grids),
+  // looked up at the point the medium's transform takes to p (media without one skip the mapping).
   double density(int i, const Vec3& p) const;
   // A value >= density(i, p) for every p in the world box.
   double max_density(int i, const Bounds& box) const;
@@ -42,6 +43,7 @@ class SceneMedia {
  private:
   std::vector<Medium> media_;
   std::vector<Bounds> medium_bounds_;
+  std::vector<Transform> to_local_;  // world -> the shape's space (the inverse of each medium's transform)
   Bounds bounds_;
 };
 
