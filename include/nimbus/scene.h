@@ -112,6 +112,7 @@ using Material = std::variant<DiffuseMaterial, HoldoutMaterial>;
 struct Surface {
   SurfaceShape shape;
   Material material = DiffuseMaterial{};
+  Transform transform;  // applied after the shape's own fields: world = transform * shape
 };
 
 struct IntegratorSettings {

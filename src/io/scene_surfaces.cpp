@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "io/mesh.h"
+#include "io/transform_json.h"
 #include "nimbus/error.h"
 
 namespace nimbus {
@@ -94,6 +95,7 @@ Surface parse_surface(JsonObject o, const std::filesystem::path& base_dir) {
   Surface s;
   s.shape = parse_surface_shape(o.object("shape"), base_dir);
   if (o.has("material")) s.material = parse_material(o.object("material"));
+  s.transform = parse_optional_transform(o);
   o.finish();
   return s;
 }

@@ -14,9 +14,13 @@ namespace nimbus {
 
 namespace {
 
+// A sphere in its own space, placed in the world by `to_world` (any invertible affine map: an ellipsoid).
 struct SphereData {
   Vec3 center;
   double radius;
+  Transform to_world, to_local;
+  bool identity = true;
+  Bounds world_bounds;
 };
 
 // What a hit on an Embree geometry means: the scene's surface and, for meshes, their vertex normals.
@@ -30,13 +34,14 @@ void sphere_bounds(const RTCBoundsFunctionArguments* args) {
   const auto* s = static_cast<const SphereData*>(args->geometryUserPtr);
   RTCBounds* b = args->bounds_o;
   // Rounded outwards so that the float box contains the double sphere.
-  const float pad = float(1e-6 * (s->radius + max_abs_component(s->center)));
-  b->lower_x = float(s->center.x - s->radius) - pad;
-  b->lower_y = float(s->center.y - s->radius) - pad;
-  b->lower_z = float(s->center.z - s->radius) - pad;
-  b->upper_x = float(s->center.x + s->radius) + pad;
-  b->upper_y = float(s->center.y + s->radius) + pad;
-  b->upper_z = float(s->center.z + s->radius) + pad;
+  const Bounds& w = s->world_bounds;
+  const float pad = float(1e-6 * (max_abs_component(w.lo) + max_abs_component(w.hi)));
+  b->lower_x = float(w.lo.x) - pad;
+  b->lower_y = float(w.lo.y) - pad;
+  b->lower_z = float(w.lo.z) - pad;
+  b->upper_x = float(w.hi.x) + pad;
+  b->upper_y = float(w.hi.y) + pad;
+  b->upper_z = float(w.hi.z) + pad;
 }
 
 // The nearest root of |o + t d - c| = r with t in (tnear, tfar), d not necessarily unit.
@@ -66,10 +71,15 @@ void sphere_intersect(const RTCIntersectFunctionNArguments* args) {
   const auto* s = static_cast<const SphereData*>(args->geometryUserPtr);
   auto* rh = reinterpret_cast<RTCRayHit*>(args->rayhit);  // N == 1: rtcIntersect1 only
   RTCRay& r = rh->ray;
-  const Vec3 o(r.org_x, r.org_y, r.org_z), d(r.dir_x, r.dir_y, r.dir_z);
+  Vec3 o(r.org_x, r.org_y, r.org_z), d(r.dir_x, r.dir_y, r.dir_z);
+  if (!s->identity) {  // the same t in the sphere's space: the map is affine
+    o = s->to_local.point(o);
+    d = s->to_local.vector(d);
+  }
   double t;
   if (!sphere_root(*s, o, d, r.tnear, r.tfar, &t)) return;
-  const Vec3 n = o + d * t - s->center;
+  Vec3 n = o + d * t - s->center;
+  if (!s->identity) n = s->to_world.normal(n);  // the world normal: the inverse transpose
   r.tfar = float(t);
   rh->hit.Ng_x = float(n.x);
   rh->hit.Ng_y = float(n.y);
@@ -84,7 +94,11 @@ void sphere_occluded(const RTCOccludedFunctionNArguments* args) {
   if (!args->valid[0]) return;
   const auto* s = static_cast<const SphereData*>(args->geometryUserPtr);
   auto* r = reinterpret_cast<RTCRay*>(args->ray);
-  const Vec3 o(r->org_x, r->org_y, r->org_z), d(r->dir_x, r->dir_y, r->dir_z);
+  Vec3 o(r->org_x, r->org_y, r->org_z), d(r->dir_x, r->dir_y, r->dir_z);
+  if (!s->identity) {
+    o = s->to_local.point(o);
+    d = s->to_local.vector(d);
+  }
   double t;
   if (sphere_root(*s, o, d, r->tnear, r->tfar, &t)) r->tfar = -std::numeric_limits<float>::infinity();
 }
@@ -117,6 +131,34 @@ void box_triangles(const BoxSurface& b, TriangleMesh* m) {
       rectangle_triangles(face, m);
     }
   }
+}
+
+// A mesh's vertices (and vertex normals) carried into the world.
+TriangleMesh transformed(const TriangleMesh& m, const Transform& xf) {
+  TriangleMesh out = m;
+  for (size_t v = 0; v < m.vertex_count(); ++v) {
+    const Vec3 p = xf.point(m.position(v));
+    for (int c = 0; c < 3; ++c) out.positions[3 * v + c] = float(p[c]);
+    if (m.normals.empty()) continue;
+    const Vec3 n = xf.normal(m.normal(v));
+    for (int c = 0; c < 3; ++c) out.normals[3 * v + c] = float(n[c]);
+  }
+  return out;
+}
+
+// The world box of a transformed sphere: for world = A x + b, the ellipsoid's half extent along axis k
+// is r |row k of A|.
+Bounds sphere_world_bounds(const SphereSurface& s, const Transform& xf) {
+  const Vec3 c = xf.point(s.center);
+  Vec3 h;
+  for (int k = 0; k < 3; ++k) {
+    const auto& row = xf.matrix()[k];
+    h[k] = s.radius * std::sqrt(row[0] * row[0] + row[1] * row[1] + row[2] * row[2]);
+  }
+  Bounds b;
+  b.extend(c - h);
+  b.extend(c + h);
+  return b;
 }
 
 }  // namespace
@@ -177,21 +219,27 @@ SceneSurfaces::SceneSurfaces(const std::vector<Surface>& surfaces) : surfaces_(s
   e.spheres.reserve(surfaces_.size());
   for (int i = 0; i < int(surfaces_.size()); ++i) {
     const SurfaceShape& shape = surfaces_[i].shape;
+    const Transform& xf = surfaces_[i].transform;
     if (const auto* s = std::get_if<SphereSurface>(&shape)) {
-      e.spheres.push_back({s->center, s->radius});
+      SphereData sd{s->center, s->radius, xf, xf.inverse(), xf.is_identity(), Bounds{}};
+      sd.world_bounds = sphere_world_bounds(*s, xf);
+      e.spheres.push_back(sd);
       e.add_sphere(&e.spheres.back(), i);
-      bounds_.extend(s->center - Vec3(s->radius));
-      bounds_.extend(s->center + Vec3(s->radius));
+      bounds_.extend(sd.world_bounds);
       continue;
     }
     const TriangleMesh* mesh = nullptr;
-    if (const auto* m = std::get_if<MeshSurface>(&shape)) {
+    if (const auto* m = std::get_if<MeshSurface>(&shape); m && xf.is_identity()) {
       mesh = m->data.get();
+    } else if (m) {
+      e.own_meshes.push_back(transformed(*m->data, xf));
+      mesh = &e.own_meshes.back();
     } else {
       e.own_meshes.emplace_back();
       if (const auto* r = std::get_if<RectangleSurface>(&shape))
         rectangle_triangles(*r, &e.own_meshes.back());
       if (const auto* b = std::get_if<BoxSurface>(&shape)) box_triangles(*b, &e.own_meshes.back());
+      if (!xf.is_identity()) e.own_meshes.back() = transformed(e.own_meshes.back(), xf);
       mesh = &e.own_meshes.back();
     }
     e.add_triangles(*mesh, i);
@@ -227,7 +275,7 @@ bool SceneSurfaces::intersect(const Vec3& o, const Vec3& d, double tmax, Surface
   hit->t = rh.ray.tfar;
   hit->p = o + d * hit->t;
   Vec3 ng = normalize(Vec3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z));
-  if (info.sphere) ng = normalize(hit->p - info.sphere->center);  // double precision
+  if (info.sphere && info.sphere->identity) ng = normalize(hit->p - info.sphere->center);  // double precision
   if (dot(ng, d) > 0.0) ng = -ng;
   hit->ng = ng;
   hit->ns = ng;

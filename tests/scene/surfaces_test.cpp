@@ -218,3 +218,60 @@ TEST(SurfaceLight, ARoofShadowsTheMediumCompletely) {
 
 }  // namespace
 }  // namespace nimbus
+
+namespace nimbus {
+namespace {
+
+// A transformed surface is the shape carried into the world: an ellipsoid from a sphere under
+// non-uniform scale, a box under a rotation, a mesh with it.
+TEST(Surfaces, TransformsCarryShapesIntoTheWorld) {
+  const Transform xf = Transform::scaling(Vec3(1.0, 2.0, 0.5))
+                           .then(Transform::rotation(Vec3(0, 0, 1), 30.0))
+                           .then(Transform::translation(Vec3(0.5, -0.25, 1.0)));
+  Surface ellipsoid{SphereSurface{Vec3(0.1, 0, 0), 0.8}, DiffuseMaterial{}};
+  ellipsoid.transform = xf;
+  Surface box{BoxSurface{Vec3(-0.5), Vec3(0.5)}, DiffuseMaterial{}};
+  box.transform = xf;
+  Surface cube{
+      MeshSurface{"cube.obj", std::make_shared<const TriangleMesh>(mesh_from_obj_text(kCubeObj, "cube.obj"))},
+      DiffuseMaterial{}};
+  cube.transform = xf;
+  const SceneSurfaces e({ellipsoid}), b({box}), m({cube});
+  const Transform to_local = xf.inverse();
+  Bounds slabs;
+  slabs.extend(Vec3(-0.5));
+  slabs.extend(Vec3(0.5));
+  Rng rng(8, 9);
+  int hits = 0;
+  for (int k = 0; k < 2000; ++k) {
+    const Vec3 o = Vec3(0.5, -0.25, 1.0) + random_direction(rng) * 4.0;
+    const Vec3 d = normalize(Vec3(0.5, -0.25, 1.0) + random_direction(rng) * 1.2 - o);
+    // In the shapes' own space the ray is o' + t d' with the same t.
+    const Vec3 lo = to_local.point(o), ld = to_local.vector(d);
+    const Vec3 oc = lo - Vec3(0.1, 0, 0);
+    const double qa = dot(ld, ld), qb = dot(oc, ld), qc = dot(oc, oc) - 0.64, disc = qb * qb - qa * qc;
+    SurfaceHit h;
+    ASSERT_EQ(e.intersect(o, d, 1e30, &h), disc > 0.0) << "ray " << k;
+    if (disc > 0.0) {
+      const double t = (-qb - std::sqrt(disc)) / qa;
+      EXPECT_NEAR(h.t, t, 1e-5 * (1.0 + t));
+      // The world normal is the inverse transpose of the local one.
+      const Vec3 n = normalize(xf.normal(lo + ld * t - Vec3(0.1, 0, 0)));
+      EXPECT_NEAR(std::abs(dot(h.ng, n)), 1.0, 1e-6);
+      ++hits;
+    }
+    double t0, t1;
+    const bool in_box = slabs.intersect(lo, ld, 0.0, 1e30, &t0, &t1);
+    if (in_box && t1 - t0 < 1e-4) continue;  // grazing an edge: either answer
+    SurfaceHit hb, hm;
+    ASSERT_EQ(b.intersect(o, d, 1e30, &hb), in_box) << "ray " << k;
+    ASSERT_EQ(m.intersect(o, d, 1e30, &hm), in_box) << "ray " << k;
+    if (!in_box) continue;
+    EXPECT_NEAR(hb.t, t0, 1e-5 * (1.0 + t0));
+    EXPECT_NEAR(hm.t, t0, 1e-5 * (1.0 + t0));
+  }
+  EXPECT_GT(hits, 300);
+}
+
+}  // namespace
+}  // namespace nimbus
