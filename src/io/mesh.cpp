@@ -28,6 +28,25 @@ std::string quoted(std::string_view field) {
   return "'" + q + (field.size() > 32 ? "...'" : "'");
 }
 
+// tinyobjloader's number parser accumulates a decimal exponent in an int, checked one digit too late:
+// an exponent of 2147483648 overflows it (undefined behaviour, found by fuzz/mesh_fuzz). A number whose
+// exponent has 10 or more digits (leading zeros aside) is refused before it gets there.
+void check_exponents(std::string_view s, size_t line, const std::string& name) {
+  while (!s.empty()) {
+    s.remove_prefix(std::min(s.find_first_not_of(" \t"), s.size()));
+    const std::string_view field = s.substr(0, s.find_first_of(" \t"));
+    s.remove_prefix(field.size());
+    size_t e = field.find_first_of("eE");
+    if (e == std::string_view::npos) continue;
+    e = field.find_first_not_of("+-", e + 1);
+    if (e == std::string_view::npos || (e = field.find_first_not_of('0', e)) == std::string_view::npos)
+      continue;
+    const size_t digits = std::min(field.find_first_not_of("0123456789", e), field.size()) - e;
+    if (digits >= 10)
+      throw Error(fmt::format("{}: line {}: number {} is out of range", name, line, quoted(field)));
+  }
+}
+
 // Checks one line before tinyobjloader reads it; true for a line it must not see. The first three
 // fields of a `v` line must be numbers: tinyobjloader reads a coordinate it cannot parse ("nan", "inf",
 // "1,5", a missing one) as 0, which would load a corrupt file as another mesh. Out-of-range numbers
@@ -42,8 +61,11 @@ bool check_line(std::string_view s, size_t line, const std::string& name) {
   if (start == std::string_view::npos || s.size() < start + 2) return false;
   if (s[start] == 't' && is_space(s[start + 1])) return true;
   if (s[start] != 'v') return false;
-  if (s.size() >= start + 3 && s[start + 1] == 'w' && is_space(s[start + 2])) return true;
-  if (!is_space(s[start + 1])) return false;
+  const char kind = is_space(s[start + 1]) ? ' ' : s[start + 1];  // v, vn, vt or vw
+  if (kind != ' ' && (s.size() < start + 3 || !is_space(s[start + 2]))) return false;
+  if (kind == 'w') return true;
+  if (kind == 'n' || kind == 't' || kind == ' ') check_exponents(s.substr(start + 2), line, name);
+  if (kind != ' ') return false;
   s.remove_prefix(start + 2);
   for (int c = 0; c < 3; ++c) {
     s.remove_prefix(std::min(s.find_first_not_of(" \t"), s.size()));

@@ -228,6 +228,19 @@ TEST(Mesh, SkinWeightsAndTagsAreIgnored) {
   EXPECT_NE(msg.find("line 5"), std::string::npos) << msg;
 }
 
+TEST(MeshErrors, ExponentsOfTenDigitsAreErrors) {
+  // tinyobjloader accumulates exponents in an int and overflowed at 2147483648 (fuzz finding).
+  EXPECT_EQ(mesh_error(triangle_with_vertex("v 0 0 1e2147483648")),
+            "cube.obj: line 1: number '1e2147483648' is out of range");
+  EXPECT_EQ(mesh_error(std::string(kTriangle) + "vn 0 0 1E+0001000000000\n"),
+            "cube.obj: line 5: number '1E+0001000000000' is out of range");
+  EXPECT_EQ(mesh_error(std::string(kTriangle) + "vt 0.5 -1e-9999999999\n"),
+            "cube.obj: line 5: number '-1e-9999999999' is out of range");
+  // Nine digits are fine (a texture coordinate is not used), and so are leading zeros.
+  EXPECT_EQ(mesh_error(std::string(kTriangle) + "vt 0.5 1e999999999\n"), "(no error)");
+  EXPECT_EQ(mesh_error(triangle_with_vertex("v 0 0 1e-0000000000001")), "(no error)");
+}
+
 TEST(MeshErrors, HugeCoordinatesAreErrors) {
   // 2^52, exact as a float, beyond kMaxMeshCoordinate.
   EXPECT_EQ(mesh_error(triangle_with_vertex("v 0 -4503599627370496 0")),
