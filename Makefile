@@ -50,7 +50,7 @@ build-fuzz/build.ninja:
 	  -DNIMBUS_FUZZ=ON -DBUILD_TESTING=OFF -DNIMBUS_BUILD_BENCH=OFF
 
 fuzz-build: deps build-fuzz/build.ninja
-	cmake --build build-fuzz -j $(JOBS) --target scene_fuzz vdb_fuzz cli_fuzz
+	cmake --build build-fuzz -j $(JOBS) --target scene_fuzz vdb_fuzz cli_fuzz mesh_fuzz
 
 fuzz-smoke: fuzz-build
 	FUZZ_SEED=1 fuzz/run.sh 60

@@ -3,7 +3,7 @@
 # other: make fuzz-smoke runs it with 60 s, make fuzz FUZZ_SECONDS=N with N. New inputs go to
 # build-fuzz/corpus/<target>/ (the committed seeds in fuzz/corpus/<target>/ are only read); a crash,
 # leak, timeout or out-of-memory input is written to build-fuzz/artifacts/<target>/ and fails the run.
-# Usage: [FUZZ_SEED=N] fuzz/run.sh SECONDS [TARGET...]   (targets: scene vdb cli; default all)
+# Usage: [FUZZ_SEED=N] fuzz/run.sh SECONDS [TARGET...]   (targets: scene vdb cli mesh; default all)
 # FUZZ_SEED: libFuzzer's -seed (default 0: a random seed); make fuzz-smoke passes 1 so that CI repeats the
 # same mutations from run to run (fork-mode job timing still varies), make fuzz leaves it random.
 set -euo pipefail
@@ -11,7 +11,7 @@ cd "$(dirname "$0")/.."
 seconds=${1:?usage: fuzz/run.sh SECONDS [TARGET...]}
 shift
 targets=("$@")
-[ ${#targets[@]} -eq 0 ] && targets=(scene vdb cli)
+[ ${#targets[@]} -eq 0 ] && targets=(scene vdb cli mesh)
 BUILD_FUZZ=${BUILD_FUZZ:-build-fuzz}
 export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1}
 export LSAN_OPTIONS=${LSAN_OPTIONS:-suppressions=$PWD/fuzz/lsan.supp}
@@ -34,7 +34,7 @@ for t in "${targets[@]}"; do
     # Release build and over 10 s under ASan, UBSan and coverage instrumentation.
     vdb) max_len=400000; asan=$asan:alloc_dealloc_mismatch=0; timeout=30
          extra=(-fork=1 -ignore_crashes=1 -ignore_timeouts=1 -ignore_ooms=1 -detect_leaks=0) ;;
-    *) max_len=4096; timeout=10 ;;
+    *) max_len=4096; timeout=10 ;;  # scene, cli, mesh (OBJ text)
   esac
   dict=()
   [ -f "fuzz/$t.dict" ] && dict=(-dict="fuzz/$t.dict")

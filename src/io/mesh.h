@@ -1,6 +1,7 @@
 // Triangle meshes from Wavefront OBJ files, through tinyobjloader: polygons triangulated, per-vertex
 // normals kept when every face corner has one. Checked: finite coordinates within kMaxMeshCoordinate,
-// indices in range, at least one triangle, no degenerate (zero-area) triangle.
+// indices in range, at least one triangle, no degenerate (zero-area) triangle; every `v` line's
+// coordinates numbers. tinyobjloader's own `vw` and `t` extensions are ignored (mesh.cpp says why).
 #pragma once
 
 #include <filesystem>

@@ -5,8 +5,10 @@
 #include <sys/resource.h>
 
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 
+#include "io/mesh.h"
 #include "io/vdb.h"
 #include "io/vdb_test_util.h"
 #include "nimbus/error.h"
@@ -127,6 +129,29 @@ TEST(FuzzRegression, StreamedOpenVdbDescriptorLengthIsChecked) {
   const std::string msg = test::load_error(fuzz_input("vdb_stream_descriptor_name_length.vdb"));
   EXPECT_NE(msg.find("corrupt OpenVDB file: instance parent needs 861877343 bytes"), std::string::npos)
       << msg;
+}
+
+// mesh_fuzz, UBSan: a `vw` (skin weight, tinyobjloader's own extension) line with the joint id 1e300:
+// tinyobjloader converts it from double to int unchecked. nimbus hides `vw` lines from it (as comments).
+TEST(FuzzRegression, ObjSkinWeightsAreHiddenFromTinyObjLoader) {
+  const auto file = fuzz_input("obj_skin_weight_joint_huge.obj");
+  try {
+    load_mesh(file, "weights.obj");
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("weights.obj: ", 0), 0u) << e.what();
+  }
+}
+
+// mesh_fuzz (make fuzz-build, 60 s), UBSan inside tinyobjloader: the exponent of "1E2147483648" overflowed
+// the int its number parser accumulates it in. nimbus refuses exponents of 10 or more digits first.
+TEST(FuzzRegression, ObjExponentThatOverflowsTinyObjLoadersIntIsRefused) {
+  const auto file = fuzz_input("obj_exponent_int_overflow.obj");
+  try {
+    load_mesh(file, "exponent.obj");
+    FAIL() << "loaded";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()), "exponent.obj: line 5: number '1E2147483648l' is out of range");
+  }
 }
 
 }  // namespace
