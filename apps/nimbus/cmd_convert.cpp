@@ -13,12 +13,13 @@ namespace {
 struct ConvertArgs {
   std::string input, output;
   double exposure = 0.0;
+  bool alpha = false;
 };
 
 int run_convert(const ConvertArgs& args) {
   ImageMetadata meta;
   const Image img = read_exr(args.input, &meta);
-  write_image(args.output, img, meta, args.exposure);
+  write_image(args.output, img, meta, args.exposure, args.alpha);
   return kExitOk;
 }
 
@@ -31,6 +32,9 @@ void add_convert_command(CLI::App& app, Action& action) {
   cmd->add_option("output", args->output, "Output image: .png (sRGB) or .exr")->required();
   cmd->add_option("--exposure", args->exposure, "Exposure in stops for PNG output")
       ->check(CLI::Range(-64.0, 64.0));
+  cmd->add_flag(
+      "--alpha", args->alpha,
+      "PNG output: keep the EXR's alpha (an RGBA PNG with straight colour) instead of the image over black");
   cmd->callback([args, &action] { action = [args] { return run_convert(*args); }; });
 }
 

@@ -40,11 +40,14 @@ void write_exr(const std::filesystem::path& path, const Image& img, const ImageM
 // attributes; further channels are not read.
 Image read_exr(const std::filesystem::path& path, ImageMetadata* meta = nullptr);
 // 8-bit sRGB (the sRGB transfer function, not a 2.2 gamma) of the RGB scaled by 2^exposure (premultiplied
-// colour: the image over black); values are clamped to [0, 1] and non-finite values written as 0.
-void write_png(const std::filesystem::path& path, const Image& img, double exposure_stops = 0.0);
+// colour: the image over black); values are clamped to [0, 1] and non-finite values written as 0. With
+// with_alpha and an image with alpha: an RGBA PNG with straight (unpremultiplied) colour, for viewers
+// and web pages that composite it themselves.
+void write_png(const std::filesystem::path& path, const Image& img, double exposure_stops = 0.0,
+               bool with_alpha = false);
 // By extension: .exr or .png (any case); anything else is an error.
 void write_image(const std::filesystem::path& path, const Image& img, const ImageMetadata& meta,
-                 double exposure_stops);
+                 double exposure_stops, bool png_alpha = false);
 
 // sRGB encoding of a linear value in [0, 1] (IEC 61966-2-1).
 double srgb_encode(double linear);

@@ -149,7 +149,7 @@ Rgb OctaveIntegrator::trace(const Ray& ray, Rng& rng, CameraSample* sample, int 
   const GatherFn gather = [&](const Ray& r) { return trace(r, rng, nullptr, bounces - 1); };
   Rgb surface_direct;
   const Rgb L_end = ray_end_radiance(ctx_, on_surface ? &hit : nullptr, exp(-tau), rng, sample,
-                                     bounces > 0 ? &gather : nullptr, &surface_direct);
+                                     bounces > 0 ? &gather : nullptr, &surface_direct, kSurfaceShadowStep);
   layers.finish(ctx_, on_surface ? Rgb(0.0) : exp(-tau), direct + surface_direct);
   return L + L_end;
 }

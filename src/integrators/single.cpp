@@ -98,8 +98,9 @@ Rgb SingleScatter::trace(const Ray& ray, Rng& rng, CameraSample* sample, int bou
   // the environment. All of single's own light is direct; a surface's gathered light is not.
   const GatherFn gather = [&](const Ray& r) { return trace(r, rng, nullptr, bounces - 1); };
   Rgb surface_direct;
-  const Rgb L_end = ray_end_radiance(ctx_, on_surface ? &hit : nullptr, T, rng, sample,
-                                     bounces > 0 ? &gather : nullptr, &surface_direct);
+  const Rgb L_end =
+      ray_end_radiance(ctx_, on_surface ? &hit : nullptr, T, rng, sample, bounces > 0 ? &gather : nullptr,
+                       &surface_direct, shadow_maps_.empty() ? 0.0 : kSurfaceShadowStep);
   layers.finish(ctx_, on_surface ? Rgb(0.0) : T, L + surface_direct);
   return L + L_end;
 }

@@ -1,17 +1,21 @@
 // Light at surfaces (integrators/surface_light.h).
 #include "integrators/surface_light.h"
 
+#include "integrators/shadow_map.h"
 #include "integrators/tracking.h"
 #include "scene/lights.h"
 
 namespace nimbus {
 
-Rgb shadow_transmittance(const SceneContext& ctx, const Vec3& p, const Vec3& w, double tmax, Rng& rng) {
+Rgb shadow_transmittance(const SceneContext& ctx, const Vec3& p, const Vec3& w, double tmax, Rng& rng,
+                         double march_step) {
   if (ctx.surfaces.occluded(p, w, tmax)) return Rgb(0.0);
+  if (march_step > 0.0) return marched_transmittance(ctx.media, ctx.majorants, p, w, tmax, march_step);
   return ratio_tracking_transmittance(ctx.media, ctx.majorants, p, w, tmax, rng);
 }
 
-Rgb surface_direct_light(const SceneContext& ctx, const SurfaceHit& hit, const Rgb& albedo, Rng& rng) {
+Rgb surface_direct_light(const SceneContext& ctx, const SurfaceHit& hit, const Rgb& albedo, Rng& rng,
+                         double march_step) {
   Rgb E(0.0);  // cosine-weighted irradiance / pi
   for (const Light& light : ctx.lights) {
     LightSample ls;
@@ -20,16 +24,16 @@ Rgb surface_direct_light(const SceneContext& ctx, const SurfaceHit& hit, const R
     const double cos_theta = dot(hit.ns, ls.wi);
     if (cos_theta <= 0.0 || dot(hit.ng, ls.wi) <= 0.0) continue;
     const Vec3 o = SceneSurfaces::offset(hit.p, hit.ng, ls.wi);
-    E += ls.weight * shadow_transmittance(ctx, o, ls.wi, ls.distance, rng) * (cos_theta / kPi);
+    E += ls.weight * shadow_transmittance(ctx, o, ls.wi, ls.distance, rng, march_step) * (cos_theta / kPi);
   }
   return albedo * E;
 }
 
 Rgb surface_radiance(const SceneContext& ctx, const SurfaceHit& hit, Rng& rng, const GatherFn* gather,
-                     Rgb* direct_part) {
+                     Rgb* direct_part, double march_step) {
   const auto* diffuse = std::get_if<DiffuseMaterial>(&ctx.surfaces.material(hit.surface));
   if (!diffuse) return Rgb(0.0);  // a holdout
-  Rgb L = surface_direct_light(ctx, hit, diffuse->albedo, rng);
+  Rgb L = surface_direct_light(ctx, hit, diffuse->albedo, rng, march_step);
   if (direct_part) *direct_part = L;
   if (!gather && !ctx.has_environment) return L;
   const double u1 = rng.uniform(), u2 = rng.uniform();
@@ -38,17 +42,17 @@ Rgb surface_radiance(const SceneContext& ctx, const SurfaceHit& hit, Rng& rng, c
   const Vec3 o = SceneSurfaces::offset(hit.p, hit.ng, wi);
   if (gather) return L + diffuse->albedo * (*gather)(Ray{o, wi});
   return L + diffuse->albedo * ctx.environment *
-                 shadow_transmittance(ctx, o, wi, std::numeric_limits<double>::infinity(), rng);
+                 shadow_transmittance(ctx, o, wi, std::numeric_limits<double>::infinity(), rng, march_step);
 }
 
 Rgb ray_end_radiance(const SceneContext& ctx, const SurfaceHit* hit, const Rgb& T, Rng& rng,
-                     CameraSample* sample, const GatherFn* gather, Rgb* direct_part) {
+                     CameraSample* sample, const GatherFn* gather, Rgb* direct_part, double march_step) {
   if (direct_part) *direct_part = Rgb(0.0);
   if (!hit) return ctx.has_environment ? T * ctx.environment : Rgb(0.0);
   if (sample) record_surface_hit(ctx, *hit, T, sample);
   if (max_component(T) <= 0.0) return Rgb(0.0);
   Rgb direct(0.0);
-  const Rgb L = T * surface_radiance(ctx, *hit, rng, gather, &direct);
+  const Rgb L = T * surface_radiance(ctx, *hit, rng, gather, &direct, march_step);
   if (direct_part) *direct_part = T * direct;
   const bool diffuse = std::holds_alternative<DiffuseMaterial>(ctx.surfaces.material(hit->surface));
   if (sample && sample->deep && diffuse) sample->deep->push_back({hit->t, hit->t, L, average(T)});

@@ -9,14 +9,21 @@
 
 namespace nimbus {
 
+// The optical-depth step of the marched shadows on surfaces (octave, mfs, single with shadow maps):
+// midpoint error O(step^2) in smooth media, well under the noise of a few spp.
+inline constexpr double kSurfaceShadowStep = 0.1;
+
 // Transmittance from p along w (unit) over (0, tmax): 0 when a surface blocks the way, else the media's
-// by ratio tracking (unbiased).
-Rgb shadow_transmittance(const SceneContext& ctx, const Vec3& p, const Vec3& w, double tmax, Rng& rng);
+// by ratio tracking (unbiased; march_step 0) or by a deterministic midpoint march with steps of
+// march_step optical depth (smooth shadows for the integrators that march: octave, mfs).
+Rgb shadow_transmittance(const SceneContext& ctx, const Vec3& p, const Vec3& w, double tmax, Rng& rng,
+                         double march_step = 0.0);
 
 // (albedo / pi) times the cosine-weighted irradiance at a diffuse surface point from every directional and
 // point light (light sampling, one sample each), through shadow_transmittance. hit.ns faces the viewer;
 // the surface is two-sided, lit on the viewer's side only.
-Rgb surface_direct_light(const SceneContext& ctx, const SurfaceHit& hit, const Rgb& albedo, Rng& rng);
+Rgb surface_direct_light(const SceneContext& ctx, const SurfaceHit& hit, const Rgb& albedo, Rng& rng,
+                         double march_step = 0.0);
 
 // The radiance that leaves a surface point towards the ray that found it, for the integrators that march
 // the camera ray (single, octave, mfs): 0 for a holdout; for a diffuse surface its direct light plus
@@ -27,14 +34,16 @@ Rgb surface_direct_light(const SceneContext& ctx, const SurfaceHit& hit, const R
 using GatherFn = std::function<Rgb(const Ray&)>;
 // *direct_part (when given) receives the lights' direct part of the result.
 Rgb surface_radiance(const SceneContext& ctx, const SurfaceHit& hit, Rng& rng, const GatherFn* gather,
-                     Rgb* direct_part = nullptr);
+                     Rgb* direct_part = nullptr, double march_step = 0.0);
 
 // The light at the end of a marched ray, seen through its transmittance T: the surface it ends on (hit,
 // through surface_radiance with `gather`; its layers recorded into a non-null sample, with a deep
 // segment for a diffuse surface), or with hit == nullptr the environment. *direct_part (when given)
 // receives the surface's direct light as seen through T (0 for the environment).
+// march_step: as for shadow_transmittance.
 Rgb ray_end_radiance(const SceneContext& ctx, const SurfaceHit* hit, const Rgb& T, Rng& rng,
-                     CameraSample* sample, const GatherFn* gather, Rgb* direct_part = nullptr);
+                     CameraSample* sample, const GatherFn* gather, Rgb* direct_part = nullptr,
+                     double march_step = 0.0);
 
 // The compositing layers of a camera ray ending on a surface, seen through transmittance T: no escape,
 // the holdout's transmittance, the shading normal, and depth and albedo unless the media in front

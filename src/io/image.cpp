@@ -106,20 +106,28 @@ Image read_exr(const fs::path& path, ImageMetadata* meta) {
   }
 }
 
-void write_png(const fs::path& path, const Image& img, double exposure_stops) {
+void write_png(const fs::path& path, const Image& img, double exposure_stops, bool with_alpha) {
   if (img.width <= 0 || img.height <= 0 || img.rgb.size() != size_t(img.width) * img.height * 3)
     throw Error(fmt::format("{}: cannot write an empty or malformed image", path.string()));
+  const bool rgba = with_alpha && img.alpha.size() == size_t(img.width) * img.height;
+  const int n = rgba ? 4 : 3;
   const double scale = std::exp2(exposure_stops);
-  std::vector<uint8_t> pixels(img.rgb.size());
-  for (size_t i = 0; i < pixels.size(); ++i) {
-    const double v = double(img.rgb[i]) * scale;
-    pixels[i] = uint8_t(std::lround(255.0 * srgb_encode(std::isfinite(v) ? v : 0.0)));
+  std::vector<uint8_t> pixels(size_t(img.width) * img.height * n);
+  for (size_t p = 0; p < size_t(img.width) * img.height; ++p) {
+    // A PNG's alpha is straight: the colour is divided by it (0 where nothing covers the pixel).
+    const double a = rgba ? std::clamp(double(img.alpha[p]), 0.0, 1.0) : 1.0;
+    for (int c = 0; c < 3; ++c) {
+      const double v = rgba ? (a > 0.0 ? double(img.rgb[3 * p + c]) / a : 0.0) * scale
+                            : double(img.rgb[3 * p + c]) * scale;
+      pixels[n * p + c] = uint8_t(std::lround(255.0 * srgb_encode(std::isfinite(v) ? v : 0.0)));
+    }
+    if (rgba) pixels[n * p + 3] = uint8_t(std::lround(255.0 * (std::isfinite(a) ? a : 0.0)));
   }
   png_image png{};
   png.version = PNG_IMAGE_VERSION;
   png.width = png_uint_32(img.width);
   png.height = png_uint_32(img.height);
-  png.format = PNG_FORMAT_RGB;
+  png.format = rgba ? PNG_FORMAT_RGBA : PNG_FORMAT_RGB;
   png_alloc_size_t size = 0;
   if (!png_image_write_to_memory(&png, nullptr, &size, 0, pixels.data(), 0, nullptr))
     throw Error(fmt::format("{}: cannot encode PNG: {}", path.string(), png.message));
@@ -130,11 +138,12 @@ void write_png(const fs::path& path, const Image& img, double exposure_stops) {
   atomic_write_bytes(path, bytes);
 }
 
-void write_image(const fs::path& path, const Image& img, const ImageMetadata& meta, double exposure_stops) {
+void write_image(const fs::path& path, const Image& img, const ImageMetadata& meta, double exposure_stops,
+                 bool png_alpha) {
   std::string ext = path.extension().string();
   for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
   if (ext == ".exr") return write_exr(path, img, meta);
-  if (ext == ".png") return write_png(path, img, exposure_stops);
+  if (ext == ".png") return write_png(path, img, exposure_stops, png_alpha);
   throw Error(fmt::format("{}: unsupported output extension '{}' (use .exr or .png)", path.string(), ext));
 }
 
