@@ -78,6 +78,29 @@ TEST(Image, PngHoldsSrgbBytesAndExposure) {
   }
 }
 
+// With alpha: straight colour, colour / alpha sRGB-encoded, alpha linear; alpha 0 is black.
+TEST(Image, PngWithAlphaHoldsStraightColour) {
+  const test::ScratchDir scratch("image_png_alpha");
+  Image img(3, 1);
+  img.alpha = {1.0f, 0.5f, 0.0f};
+  const float premultiplied[3] = {0.5f, 0.125f, 0.0f};
+  for (int x = 0; x < 3; ++x) img.pixel(x, 0)[0] = img.pixel(x, 0)[1] = img.pixel(x, 0)[2] = premultiplied[x];
+  write_png(scratch.path / "a.png", img, 0.0, true);
+  png_image png{};
+  png.version = PNG_IMAGE_VERSION;
+  ASSERT_TRUE(png_image_begin_read_from_file(&png, (scratch.path / "a.png").c_str()));
+  EXPECT_TRUE(png.format & PNG_FORMAT_FLAG_ALPHA);
+  png.format = PNG_FORMAT_RGBA;
+  std::vector<uint8_t> px(PNG_IMAGE_SIZE(png));
+  ASSERT_TRUE(png_image_finish_read(&png, nullptr, px.data(), 0, nullptr));
+  // 0.5 / 1 and 0.125 / 0.5 = 0.25 in sRGB: 188 and 137.
+  const int colour[3] = {188, 137, 0}, alpha[3] = {255, 128, 0};
+  for (int x = 0; x < 3; ++x) {
+    EXPECT_EQ(px[x * 4], colour[x]) << "pixel " << x;
+    EXPECT_EQ(px[x * 4 + 3], alpha[x]) << "pixel " << x;
+  }
+}
+
 TEST(Image, FailedWritesKeepTheOldFileAndLeaveNoTemporaries) {
   const test::ScratchDir scratch("image_atomic");
   const fs::path& dir = scratch.path;
