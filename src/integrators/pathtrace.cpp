@@ -189,7 +189,7 @@ Rgb PathTracer::Li(const Ray& ray, Rng& rng, CameraSample* sample) const {
       if (!goes_on || (max_events_ > 0 && events + 1 >= max_events_)) break;
       d = cosine_direction(hit.ns, rng.uniform(), rng.uniform());
       if (dot(d, hit.ng) <= 0.0) break;  // below the geometric surface (shading normals): absorbed
-      o = SceneSurfaces::offset(hit.p, hit.ng, d);
+      o = SceneSurfaces::offset(hit, d);
     } else if (escaped) {
       if (events == 0) first.end(true, beta, scatter_p);
       // Only camera rays see the environment directly; later escapes were counted by NEE.

@@ -90,7 +90,7 @@ void walk_photon(const SceneContext& ctx, Vec3 x, Vec3 w, Rng& rng, double* coll
     if (reached && to_surface) {
       on_flight(x, w, surface.t);
       if (!on_surface(surface, &w)) return;
-      x = SceneSurfaces::offset(surface.p, surface.ng, w);
+      x = SceneSurfaces::offset(surface, w);
       continue;
     }
     on_flight(x, w, hit ? (xc - x).length() : kInf);

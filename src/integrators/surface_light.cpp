@@ -23,7 +23,7 @@ Rgb surface_direct_light(const SceneContext& ctx, const SurfaceHit& hit, const R
     if (!sample_light(light, hit.p, u1, u2, &ls)) continue;
     const double cos_theta = dot(hit.ns, ls.wi);
     if (cos_theta <= 0.0 || dot(hit.ng, ls.wi) <= 0.0) continue;
-    const Vec3 o = SceneSurfaces::offset(hit.p, hit.ng, ls.wi);
+    const Vec3 o = SceneSurfaces::offset(hit, ls.wi);
     E += ls.weight * shadow_transmittance(ctx, o, ls.wi, ls.distance, rng, march_step) * (cos_theta / kPi);
   }
   return albedo * E;
@@ -39,7 +39,7 @@ Rgb surface_radiance(const SceneContext& ctx, const SurfaceHit& hit, Rng& rng, c
   const double u1 = rng.uniform(), u2 = rng.uniform();
   const Vec3 wi = cosine_direction(hit.ns, u1, u2);
   if (dot(hit.ng, wi) <= 0.0) return L;
-  const Vec3 o = SceneSurfaces::offset(hit.p, hit.ng, wi);
+  const Vec3 o = SceneSurfaces::offset(hit, wi);
   if (gather) return L + diffuse->albedo * (*gather)(Ray{o, wi});
   return L + diffuse->albedo * ctx.environment *
                  shadow_transmittance(ctx, o, wi, std::numeric_limits<double>::infinity(), rng, march_step);

@@ -311,9 +311,9 @@ bool SceneSurfaces::occluded(const Vec3& o, const Vec3& d, double tmax) const {
   return r.tfar < 0.0f;
 }
 
-Vec3 SceneSurfaces::offset(const Vec3& p, const Vec3& ng, const Vec3& d) {
-  const double eps = 1e-5 * (1.0 + max_abs_component(p));
-  return p + (dot(ng, d) >= 0.0 ? ng : -ng) * eps;
+Vec3 SceneSurfaces::offset(const SurfaceHit& hit, const Vec3& d) {
+  const double eps = 1e-5 * (max_abs_component(hit.p) + hit.t);
+  return hit.p + (dot(hit.ng, d) >= 0.0 ? hit.ng : -hit.ng) * eps;
 }
 
 }  // namespace nimbus

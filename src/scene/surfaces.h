@@ -39,9 +39,10 @@ class SceneSurfaces {
   // Whether any surface lies on o + t d for t in (0, tmax). Always false without surfaces.
   bool occluded(const Vec3& o, const Vec3& d, double tmax) const;
 
-  // A ray origin for leaving a surface point p (geometric normal ng) in direction d: p moved off the
-  // surface to d's side by a distance that covers float rounding of the hit point.
-  static Vec3 offset(const Vec3& p, const Vec3& ng, const Vec3& d);
+  // A ray origin for leaving the hit point in direction d: moved off the surface to d's side by
+  // 1e-5 (|p| + t), which covers the float rounding of the hit (Embree intersects in float: the error
+  // grows with the coordinates and with the distance travelled) in scenes of any unit.
+  static Vec3 offset(const SurfaceHit& hit, const Vec3& d);
 
  private:
   struct Embree;
