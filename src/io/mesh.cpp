@@ -9,10 +9,11 @@
 #include <charconv>
 #include <cmath>
 #include <fstream>
-#include <map>
-#include <sstream>
+#include <limits>
 #include <string_view>
+#include <unordered_map>
 #include <utility>
+#include <vector>
 
 #include "nimbus/error.h"
 
@@ -104,9 +105,34 @@ const std::string& checked_text(const std::string& text, const std::string& name
   return copied ? *masked : text;
 }
 
-// One output vertex per distinct (position, normal) pair of the face corners.
+// One output vertex per distinct (position, normal) pair of the face corners, numbered in the order the
+// corners first use them. Most positions go with one normal (or none): the first pair of each position
+// is kept in a table indexed by the position, and only further pairs (hard edges) go into a hash map.
+// (It replaced a std::map of every pair: docs/benchmarks.md, "Surfaces (issue 10)".)
+class VertexTable {
+ public:
+  explicit VertexTable(size_t positions) : first_(positions, {-1, kNone}) {}
+  // The output index of (v, n) (n = -1: no normal), or kNone after entering `next` for a new pair.
+  uint32_t find_or_add(int v, int n, uint32_t next) {
+    auto& [first_n, first_out] = first_[size_t(v)];
+    if (first_out == kNone) {
+      first_n = n;
+      first_out = next;
+      return kNone;
+    }
+    if (first_n == n) return first_out;
+    const auto [it, inserted] = more_.try_emplace((uint64_t(uint32_t(v)) << 32) | uint32_t(n), next);
+    return inserted ? kNone : it->second;
+  }
+  static constexpr uint32_t kNone = std::numeric_limits<uint32_t>::max();
+
+ private:
+  std::vector<std::pair<int, uint32_t>> first_;  // per position: its first normal and output vertex
+  std::unordered_map<uint64_t, uint32_t> more_;  // (position << 32 | normal) of the further pairs
+};
+
 uint32_t vertex_for(const tinyobj::attrib_t& a, const tinyobj::index_t& idx, bool with_normals,
-                    std::map<std::pair<int, int>, uint32_t>& seen, TriangleMesh& m, const std::string& name) {
+                    VertexTable& seen, TriangleMesh& m, const std::string& name) {
   const size_t nv = a.vertices.size() / 3, nn = a.normals.size() / 3;
   if (idx.vertex_index < 0)  // a relative index (-k) reaching back past the first vertex
     throw Error(fmt::format("{}: a face refers to a vertex before the first one", name));
@@ -115,8 +141,9 @@ uint32_t vertex_for(const tinyobj::attrib_t& a, const tinyobj::index_t& idx, boo
   const int n = with_normals ? idx.normal_index : -1;
   if (with_normals && size_t(n) >= nn)
     throw Error(fmt::format("{}: a face refers to normal {} of {}", name, n + 1, nn));
-  const auto [it, inserted] = seen.try_emplace({idx.vertex_index, n}, uint32_t(m.vertex_count()));
-  if (!inserted) return it->second;
+  const uint32_t out = uint32_t(m.vertex_count());
+  if (const uint32_t known = seen.find_or_add(idx.vertex_index, n, out); known != VertexTable::kNone)
+    return known;
   for (int c = 0; c < 3; ++c) {
     const double x = a.vertices[3 * size_t(idx.vertex_index) + c];
     if (!(std::abs(x) <= kMaxMeshCoordinate))
@@ -130,7 +157,7 @@ uint32_t vertex_for(const tinyobj::attrib_t& a, const tinyobj::index_t& idx, boo
       m.normals.push_back(std::isfinite(x) ? float(x) : 0.0f);  // a bad normal falls back to the face's
     }
   }
-  return it->second;
+  return out;
 }
 
 void check_triangle(const TriangleMesh& m, size_t t, const std::string& name) {
@@ -163,7 +190,7 @@ TriangleMesh mesh_from_obj_text(const std::string& text, const std::string& name
     for (const tinyobj::index_t& idx : s.mesh.indices) with_normals = with_normals && idx.normal_index >= 0;
 
   TriangleMesh m;
-  std::map<std::pair<int, int>, uint32_t> seen;
+  VertexTable seen(a.vertices.size() / 3);
   for (const tinyobj::shape_t& s : reader.GetShapes()) {
     size_t corner = 0;
     for (const unsigned char fv : s.mesh.num_face_vertices) {
@@ -191,11 +218,16 @@ std::shared_ptr<const TriangleMesh> load_mesh(const std::filesystem::path& file,
   if (std::filesystem::is_directory(file, ec)) throw Error(fmt::format("{}: is a directory", name));
   // A FIFO or a device would block the read or never end (the volume loader refuses them the same way).
   if (!std::filesystem::is_regular_file(file, ec)) throw Error(fmt::format("{}: not a regular file", name));
-  std::ifstream in(file, std::ios::binary);
+  std::ifstream in(file, std::ios::binary | std::ios::ate);
   if (!in) throw Error(fmt::format("{}: cannot be opened for reading", name));
-  std::ostringstream text;
-  text << in.rdbuf();
-  return std::make_shared<const TriangleMesh>(mesh_from_obj_text(text.str(), name));
+  // One sized read of the whole file (a stringstream's rdbuf copy was a third of a 1M-triangle load:
+  // docs/benchmarks.md, "Surfaces (issue 10)").
+  const std::streamoff size = in.tellg();
+  if (size < 0) throw Error(fmt::format("{}: cannot be read", name));
+  std::string text(size_t(size), '\0');
+  in.seekg(0);
+  if (!in.read(text.data(), size)) throw Error(fmt::format("{}: cannot be read", name));
+  return std::make_shared<const TriangleMesh>(mesh_from_obj_text(text, name));
 }
 
 }  // namespace nimbus
