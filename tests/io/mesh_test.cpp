@@ -209,7 +209,8 @@ TEST(MeshErrors, MalformedCoordinatesAreErrors) {
   EXPECT_EQ(mesh_error(triangle_with_vertex("v " + std::string(100, 'x') + " 0 0")),
             "cube.obj: line 1: vertex coordinate '" + std::string(32, 'x') + "...' is not a number");
   EXPECT_EQ(mesh_error(triangle_with_vertex(std::string("v 0 \x01\xff 0"))),
-            "cube.obj: line 1: vertex coordinate '??' is not a number");
+            "cube.obj: line 1: vertex coordinate '?"
+            "?' is not a number");
 }
 
 TEST(Mesh, SkinWeightsAndTagsAreIgnored) {
