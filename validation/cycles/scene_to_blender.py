@@ -243,10 +243,10 @@ def import_obj(name, path):
     obj.matrix_world = Matrix.Identity(4)
     got = np.array([tuple(v.co) for v in obj.data.vertices], dtype=np.float64)
     want = obj_vertices(path)
-    lo, hi = want.min(0), want.max(0)
-    if got.shape != want.shape or not (np.allclose(got.min(0), lo, atol=1e-5) and np.allclose(got.max(0), hi, atol=1e-5)):
+    srt = lambda a: a[np.lexsort(a.T[::-1])]  # noqa: E731
+    if got.shape != want.shape or not np.allclose(srt(got), srt(want), atol=1e-5):
         raise ValueError(f"{name}: {path}: imported vertices do not match the file's coordinates "
-                         f"(bounds {got.min(0)}..{got.max(0)} vs {lo}..{hi})")
+                         f"(bounds {got.min(0)}..{got.max(0)} vs {want.min(0)}..{want.max(0)})")
     obj.data.materials.clear()
     for p in obj.data.polygons:
         p.material_index = 0
