@@ -17,6 +17,14 @@ Mapping (docs/validation/cycles.md explains and checks each line):
                densities w * sigma_s and (1 - w) * sigma_s, but Cycles 3.4 gets their weights
                wrong (refused unless --allow-multi-lobe). Box = cube mesh (exact); sphere = UV sphere whose
                radius is scaled so that the polyhedron's volume equals the sphere's (deviation reported).
+  surfaces     sphere = smooth-shaded UV sphere (same segments, scaled to the sphere's volume);
+               rectangle = a 4-vertex plane with width along normal x up, height along up; box =
+               cube mesh; mesh = bpy.ops.wm.obj_import with forward_axis Y, up_axis Z (OBJ x, y, z
+               = world x, y, z, as nimbus reads it; checked against the file's v lines). diffuse =
+               Diffuse BSDF (roughness 0, Color = albedo); holdout = Holdout shader. Cycles surfaces
+               are two-sided like nimbus'. Shadow-terminator offsets are set to 0.
+  transform    on media and surfaces: matrix_world = T R_n ... R_1 S (or the row-major matrix) times
+               the shape's own placement.
   directional  SUN lamp, Strength = irradiance (W/m^2), Color = irradiance / max, angle = angular
                diameter (use 0: Cycles' disc radiance is S/(pi tan^2(a/2)), nimbus' S/(pi sin^2(a/2))).
   point        POINT lamp, radius 0, Power P = 4 pi I (Cycles: I = P / (4 pi) W/sr, eval_fac = 1/(4 pi)).
@@ -27,6 +35,7 @@ import argparse
 import json
 import math
 import sys
+from pathlib import Path
 
 import bmesh
 import bpy
@@ -183,21 +192,145 @@ def box_mesh(name, lo, hi):
     return mesh
 
 
+def transform_matrix(t):
+    """A nimbus `transform` block as a 4x4 Matrix: T R_n ... R_1 S, or the row-major `matrix`."""
+    if not t:
+        return Matrix.Identity(4)
+    if "matrix" in t:
+        m = Matrix([[float(v) for v in row] for row in t["matrix"]])
+        return m
+    sc = t.get("scale", 1.0)
+    sc = [float(sc)] * 3 if isinstance(sc, (int, float)) else [float(v) for v in sc]
+    m = Matrix.Diagonal(Vector((*sc, 1.0)))
+    for r in t.get("rotate", []):
+        m = Matrix.Rotation(math.radians(float(r["degrees"])), 4, Vector(r["axis"]).normalized()) @ m
+    return Matrix.Translation(Vector(t.get("translate", [0, 0, 0]))) @ m
+
+
+def rectangle_mesh(name, shape):
+    c = Vector(shape.get("center", [0, 0, 0]))
+    n = Vector(shape.get("normal", [0, 0, 1])).normalized()
+    up = Vector(shape.get("up", [0, 1, 0]))
+    up = (up - up.dot(n) * n).normalized()
+    right = n.cross(up)
+    w, h = (float(v) / 2.0 for v in shape["size"])
+    verts = [c - w * right - h * up, c + w * right - h * up, c + w * right + h * up, c - w * right + h * up]
+    mesh = bpy.data.meshes.new(name)
+    mesh.from_pydata([tuple(v) for v in verts], [], [(0, 1, 2, 3)])
+    return mesh
+
+
+def obj_vertices(path):
+    out = []
+    with open(path) as f:
+        for line in f:
+            p = line.split()
+            if p and p[0] == "v":
+                out.append(tuple(float(x) for x in p[1:4]))
+    return np.array(out, dtype=np.float64)
+
+
+def import_obj(name, path):
+    before = set(bpy.data.objects)
+    bpy.ops.wm.obj_import(filepath=path, forward_axis="Y", up_axis="Z")
+    new = [o for o in bpy.data.objects if o not in before and o.type == "MESH"]
+    if len(new) != 1:
+        raise ValueError(f"{name}: {path}: expected one mesh object from the OBJ importer, got {len(new)}")
+    obj = new[0]
+    obj.name = name
+    # The importer may place the object with a matrix: bake it, then check OBJ coords = world coords.
+    obj.data.transform(obj.matrix_world)
+    obj.matrix_world = Matrix.Identity(4)
+    got = np.array([tuple(v.co) for v in obj.data.vertices], dtype=np.float64)
+    want = obj_vertices(path)
+    srt = lambda a: a[np.lexsort(a.T[::-1])]  # noqa: E731
+    if got.shape != want.shape or not np.allclose(srt(got), srt(want), atol=1e-5):
+        raise ValueError(f"{name}: {path}: imported vertices do not match the file's coordinates "
+                         f"(bounds {got.min(0)}..{got.max(0)} vs {want.min(0)}..{want.max(0)})")
+    obj.data.materials.clear()
+    for p in obj.data.polygons:
+        p.material_index = 0
+    return obj, {"mesh": path, "vertices": len(got), "faces": len(obj.data.polygons)}
+
+
+def surface_material(name, material):
+    mat = bpy.data.materials.new(name)
+    mat.use_nodes = True
+    nt = mat.node_tree
+    nt.nodes.clear()
+    out = nt.nodes.new("ShaderNodeOutputMaterial")
+    kind = material.get("type", "diffuse")
+    if kind == "diffuse":
+        d = nt.nodes.new("ShaderNodeBsdfDiffuse")
+        d.inputs["Color"].default_value = (*rgb(material.get("albedo", 0.8)), 1.0)
+        d.inputs["Roughness"].default_value = 0.0
+        nt.links.new(d.outputs[0], out.inputs["Surface"])
+    elif kind == "holdout":
+        h = nt.nodes.new("ShaderNodeHoldout")
+        nt.links.new(h.outputs[0], out.inputs["Surface"])
+    else:
+        raise ValueError(f"{name}: material '{kind}' has no Cycles equivalent here")
+    return mat
+
+
+def no_terminator_offset(obj):
+    for holder in (obj, getattr(obj, "cycles", None)):
+        for attr in ("shadow_terminator_offset", "shadow_terminator_geometry_offset",
+                     "shadow_terminator_shading_offset"):
+            if holder is not None and hasattr(holder, attr):
+                setattr(holder, attr, 0.0)
+
+
+def build_surfaces(surfaces, segments, scene_dir):
+    notes = []
+    for i, surf in enumerate(surfaces):
+        shape = surf["shape"]
+        name = f"surface{i}"
+        kind = shape["type"]
+        placement = Matrix.Identity(4)
+        if kind == "sphere":
+            mesh, info = sphere_mesh(name, float(shape["radius"]), segments)
+            for p in mesh.polygons:
+                p.use_smooth = True
+            obj = link(bpy.data.objects.new(name, mesh))
+            placement = Matrix.Translation(Vector(shape.get("center", [0, 0, 0])))
+        elif kind == "rectangle":
+            obj = link(bpy.data.objects.new(name, rectangle_mesh(name, shape)))
+            info = "4-vertex plane (exact)"
+        elif kind == "box":
+            obj = link(bpy.data.objects.new(name, box_mesh(name, shape["min"], shape["max"])))
+            info = "cube mesh (exact)"
+        elif kind == "mesh":
+            path = shape["file"]
+            if not path.startswith("/"):
+                path = str(scene_dir / path)
+            obj, info = import_obj(name, path)
+        else:
+            raise ValueError(f"{name}: surface shape '{kind}' is not supported")
+        obj.matrix_world = transform_matrix(surf.get("transform")) @ placement
+        obj.data.materials.append(surface_material(name, surf.get("material", {"type": "diffuse"})))
+        no_terminator_offset(obj)
+        notes.append({name: info})
+    return notes
+
+
 def build_media(media, segments):
     notes = []
     for i, medium in enumerate(media):
         shape = medium["shape"]
         name = f"medium{i}"
+        placement = Matrix.Identity(4)
         if shape["type"] == "sphere":
             mesh, info = sphere_mesh(name, float(shape["radius"]), segments)
             obj = link(bpy.data.objects.new(name, mesh))
-            obj.location = Vector(shape.get("center", [0, 0, 0]))
+            placement = Matrix.Translation(Vector(shape.get("center", [0, 0, 0])))
             notes.append({name: info})
         elif shape["type"] == "box":
             obj = link(bpy.data.objects.new(name, box_mesh(name, shape["min"], shape["max"])))
             notes.append({name: "cube mesh (exact)"})
         else:
             raise ValueError(f"{name}: shape '{shape['type']}' is not supported (homogeneous sphere/box only)")
+        obj.matrix_world = transform_matrix(medium.get("transform")) @ placement
         obj.data.materials.append(volume_material(name, medium))
     return notes
 
@@ -305,9 +438,13 @@ def main():
     ALLOW_MULTI_LOBE = args.allow_multi_lobe
     with open(args.scene) as f:
         scene_json = json.load(f)
+    if scene_json.get("film", {}).get("transparent", False):
+        raise ValueError("film.transparent: only the opaque film (RGB compared) is supported")
     bpy.ops.wm.read_factory_settings(use_empty=True)
     cam_info = build_camera(scene_json["camera"])
     mesh_info = build_media(scene_json.get("media", []), args.sphere_segments)
+    mesh_info += build_surfaces(scene_json.get("surfaces", []), args.sphere_segments,
+                                Path(args.scene).resolve().parent)
     build_lights(scene_json.get("lights", []))
     configure(args, scene_json.get("integrator", {}))
     print("scene_to_blender:", json.dumps({"camera": cam_info, "media": mesh_info,
