@@ -7,6 +7,7 @@
 
 #include "core/json_reader.h"
 #include "integrators/registry.h"
+#include "io/scene_fields.h"
 #include "io/scene_surfaces.h"
 #include "io/scene_volumes.h"
 #include "io/transform_json.h"
@@ -65,10 +66,7 @@ Shape parse_shape(JsonObject o, const std::filesystem::path& base_dir) {
     shape = s;
   } else if (type == "box") {
     BoxShape b;
-    b.min = o.vec3("min");
-    b.max = o.vec3("max");
-    for (int a = 0; a < 3; ++a)
-      if (!(b.max[a] > b.min[a])) o.fail("max", "must exceed min on every axis");
+    read_box_corners(o, &b.min, &b.max);
     shape = b;
   } else if (type == "vdb") {
     VdbShape v;

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "io/mesh.h"
+#include "io/scene_fields.h"
 #include "io/transform_json.h"
 #include "nimbus/error.h"
 
@@ -48,16 +49,12 @@ SurfaceShape parse_surface_shape(JsonObject o, const std::filesystem::path& base
     shape = r;
   } else if (type == "box") {
     BoxSurface b;
-    b.min = o.vec3("min");
-    b.max = o.vec3("max");
-    for (int a = 0; a < 3; ++a)
-      if (!(b.max[a] > b.min[a])) o.fail("max", "must exceed min on every axis");
+    read_box_corners(o, &b.min, &b.max);
     shape = b;
   } else if (type == "mesh") {
     MeshSurface m;
     m.file = o.string("file");
-    const std::filesystem::path file =
-        std::filesystem::path(m.file).is_absolute() ? std::filesystem::path(m.file) : base_dir / m.file;
+    const std::filesystem::path file = resolve_scene_path(base_dir, m.file);
     try {
       m.data = load_mesh(file, m.file);
     } catch (const Error& e) {

@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 #include <nanovdb/util/GridBuilder.h>
 
+#include "io/scene_fields.h"
 #include "io/vdb.h"
 #include "media/cloud.h"
 #include "nimbus/error.h"
@@ -12,8 +13,7 @@ namespace nimbus {
 
 void load_vdb_shape(VdbShape& v, const std::filesystem::path& base_dir, const std::string& where,
                     const std::string& json_path) {
-  const std::filesystem::path file =
-      std::filesystem::path(v.file).is_absolute() ? std::filesystem::path(v.file) : base_dir / v.file;
+  const std::filesystem::path file = resolve_scene_path(base_dir, v.file);
   try {
     v.data = std::make_shared<const DensityGrid>(load_density_grid(file, v.grid));
   } catch (const Error& e) {

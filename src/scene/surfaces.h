@@ -28,9 +28,7 @@ class SceneSurfaces {
   SceneSurfaces& operator=(const SceneSurfaces&) = delete;
 
   bool empty() const { return surfaces_.empty(); }
-  int count() const { return int(surfaces_.size()); }
   const Material& material(int i) const { return surfaces_[i].material; }
-  bool is_holdout(int i) const { return std::holds_alternative<HoldoutMaterial>(surfaces_[i].material); }
   // Bounds of all surfaces (empty when there are none).
   const Bounds& bounds() const { return bounds_; }
 
