@@ -103,6 +103,24 @@ void sphere_occluded(const RTCOccludedFunctionNArguments* args) {
   if (sphere_root(*s, o, d, r->tnear, r->tfar, &t)) r->tfar = -std::numeric_limits<float>::infinity();
 }
 
+// Embree's single-precision ray o + t d, t in [0, tmax) (an infinite tmax stays infinite).
+RTCRay embree_ray(const Vec3& o, const Vec3& d, double tmax) {
+  RTCRay r;
+  r.org_x = float(o.x);
+  r.org_y = float(o.y);
+  r.org_z = float(o.z);
+  r.dir_x = float(d.x);
+  r.dir_y = float(d.y);
+  r.dir_z = float(d.z);
+  r.tnear = 0.0f;
+  r.tfar = tmax < 3e38 ? float(tmax) : std::numeric_limits<float>::infinity();
+  r.mask = ~0u;
+  r.flags = 0;
+  r.time = 0.0f;
+  r.id = 0;
+  return r;
+}
+
 // The triangles of a rectangle and of a box (two per face).
 void rectangle_triangles(const RectangleSurface& r, TriangleMesh* m) {
   const Vec3 n = normalize(r.normal);
@@ -256,17 +274,7 @@ bool SceneSurfaces::intersect(const Vec3& o, const Vec3& d, double tmax, Surface
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
   RTCRayHit rh;
-  rh.ray.org_x = float(o.x);
-  rh.ray.org_y = float(o.y);
-  rh.ray.org_z = float(o.z);
-  rh.ray.dir_x = float(d.x);
-  rh.ray.dir_y = float(d.y);
-  rh.ray.dir_z = float(d.z);
-  rh.ray.tnear = 0.0f;
-  rh.ray.tfar = tmax < 3e38 ? float(tmax) : std::numeric_limits<float>::infinity();
-  rh.ray.mask = ~0u;
-  rh.ray.flags = 0;
-  rh.ray.time = 0.0f;
+  rh.ray = embree_ray(o, d, tmax);
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
   rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
   rtcIntersect1(embree_->scene, &context, &rh);
@@ -295,18 +303,7 @@ bool SceneSurfaces::occluded(const Vec3& o, const Vec3& d, double tmax) const {
   if (!embree_) return false;
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
-  RTCRay r;
-  r.org_x = float(o.x);
-  r.org_y = float(o.y);
-  r.org_z = float(o.z);
-  r.dir_x = float(d.x);
-  r.dir_y = float(d.y);
-  r.dir_z = float(d.z);
-  r.tnear = 0.0f;
-  r.tfar = tmax < 3e38 ? float(tmax) : std::numeric_limits<float>::infinity();
-  r.mask = ~0u;
-  r.flags = 0;
-  r.time = 0.0f;
+  RTCRay r = embree_ray(o, d, tmax);
   rtcOccluded1(embree_->scene, &context, &r);
   return r.tfar < 0.0f;
 }
