@@ -8,6 +8,7 @@
 #include "core/json_reader.h"
 #include "integrators/registry.h"
 #include "io/scene_fields.h"
+#include "io/scene_lights.h"
 #include "io/scene_surfaces.h"
 #include "io/scene_volumes.h"
 #include "io/transform_json.h"
@@ -20,13 +21,6 @@
 namespace nimbus {
 
 namespace {
-
-Vec3 unit_direction(JsonObject& o, const std::string& key) {
-  const Vec3 d = o.vec3(key);
-  const double len = length(d);
-  if (!(len > 1e-12)) o.fail(key, "must have non-zero length");
-  return d / len;
-}
 
 double g_value(JsonObject& o, const std::string& key, double fallback) {
   const double g = o.number(key, -1e300, 1e300, fallback);
@@ -102,31 +96,6 @@ Medium parse_medium(JsonObject o, const std::filesystem::path& base_dir) {
   return m;
 }
 
-Light parse_light(JsonObject o) {
-  const std::string type = o.string("type");
-  Light light;
-  if (type == "directional") {
-    DirectionalLight d;
-    d.direction = unit_direction(o, "direction");
-    d.irradiance = o.rgb("irradiance", 0.0);
-    d.angular_diameter_deg = o.number("angular_diameter_deg", 0.0, 90.0, 0.0);
-    light = d;
-  } else if (type == "point") {
-    PointLight p;
-    p.position = o.vec3("position");
-    p.intensity = o.rgb("intensity", 0.0);
-    light = p;
-  } else if (type == "environment") {
-    EnvironmentLight e;
-    e.radiance = o.rgb("radiance", 0.0);
-    light = e;
-  } else {
-    o.fail("type", fmt::format("unknown light '{}' (known: directional, point, environment)", type));
-  }
-  o.finish();
-  return light;
-}
-
 Camera parse_camera(JsonObject o) {
   Camera c;
   c.position = o.vec3("position");
@@ -200,7 +169,8 @@ Scene parse_scene(const nlohmann::json& doc, const std::string& name, const std:
   if (root.has("surfaces"))
     for (JsonObject& s : root.array_of_objects("surfaces", true))
       scene.surfaces.push_back(parse_surface(s, base_dir));
-  for (JsonObject& l : root.array_of_objects("lights", true)) scene.lights.push_back(parse_light(l));
+  for (JsonObject& l : root.array_of_objects("lights", true))
+    scene.lights.push_back(parse_light(l, base_dir));
   if (root.has("integrator"))
     scene.integrator = parse_integrator(doc["integrator"], root.object("integrator"));
   if (root.has("film")) scene.film = parse_film(root.object("film"));

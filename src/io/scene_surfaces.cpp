@@ -14,12 +14,6 @@ namespace nimbus {
 
 namespace {
 
-Vec3 nonzero_vec3(JsonObject& o, const std::string& key, const Vec3& fallback) {
-  const Vec3 v = o.vec3(key, fallback);
-  if (!(length(v) > 1e-12)) o.fail(key, "must have non-zero length");
-  return v;
-}
-
 // `size`: [width, height], both > 0.
 void rectangle_size(JsonObject& o, RectangleSurface* r) {
   const nlohmann::json& j = o.raw("size");
