@@ -3,6 +3,8 @@
 
 #include <csignal>
 #include <filesystem>
+#include <functional>
+#include <nlohmann/json.hpp>
 #include <optional>
 
 #include "commands.h"
@@ -37,6 +39,8 @@ struct RenderArgs {
   int deep_samples = 32;
   int threads = 0;
   double exposure = 0.0;
+  double time_limit = 0.0;  // --time: seconds, 0 = none
+  std::string resume;       // --resume: the EXR to continue
   bool quiet = false;
 };
 
@@ -49,12 +53,13 @@ std::string lower_extension(const std::filesystem::path& p) {
 // The name a partial (interrupted) image is written under: OUT.partial.EXT, so that an existing
 // complete output is never replaced by an interrupted run.
 std::filesystem::path partial_name(const std::filesystem::path& out) {
+  if (out.stem().extension() == ".partial") return out;  // resuming a partial image: it grows in place
   std::filesystem::path p = out;
   p.replace_extension(".partial" + out.extension().string());
   return p;
 }
 
-int run_render(const RenderArgs& args) {
+void check_output_names(const RenderArgs& args) {
   const std::filesystem::path out(args.output);
   const std::string ext = lower_extension(out);
   if (ext != ".exr" && ext != ".png")
@@ -69,19 +74,77 @@ int run_render(const RenderArgs& args) {
   std::error_code ec;
   if (!std::filesystem::is_directory(dir, ec))
     throw Error(fmt::format("{}: output directory '{}' does not exist", args.output, dir.string()));
+}
 
-  const Scene scene = args.scene.empty() ? builtin_demo_scene() : load_scene(args.scene);
+std::string meta_value(const ImageMetadata& meta, const std::string& key, const std::string& file) {
+  for (const auto& [k, v] : meta)
+    if (k == key) return v;
+  throw Error(fmt::format("{}: no {} in the header (not a nimbus render?)", file, key));
+}
 
+// --resume FILE: the scene, spp and film state of a nimbus EXR. The render goes on to args.spp, or to
+// the spp the file asked for.
+Scene resume_scene(const RenderArgs& args, FilmState* state, std::optional<int>* spp) {
+  if (!args.scene.empty())
+    throw Error(
+        fmt::format("--resume: {}: the scene comes from the EXR's header; give no scene file", args.scene));
+  if (args.integrator || args.seed || args.layers_given || !args.deep.empty())
+    throw Error("--resume: --integrator, --seed, --layers and --deep must be those of the resumed render");
+  ImageMetadata meta;
+  read_exr(args.resume, &meta);
+  *state = read_exr_state(args.resume);
+  const std::filesystem::path file(meta_value(meta, "nimbus/scene_file", args.resume));
+  nlohmann::json doc;
+  try {
+    doc = nlohmann::json::parse(meta_value(meta, "nimbus/scene", args.resume));
+  } catch (const nlohmann::json::exception&) {
+    throw Error(fmt::format("{}: nimbus/scene: not valid JSON", args.resume));
+  }
+  Scene scene = parse_scene(doc, args.resume + " (nimbus/scene)", file.parent_path());
+  scene.file = file;
+  const int requested = scene.integrator.spp;
+  *spp = args.spp ? *args.spp : requested;
+  if (**spp <= state->spp)
+    throw Error(
+        fmt::format("--resume: {} has {} spp already; ask for more with --spp", args.resume, state->spp));
+  return scene;
+}
+
+// Writes the image (with its film state in an EXR), the preview and the deep image under `out`.
+void write_outputs(const RenderArgs& args, const RenderResult& r, const std::filesystem::path& out,
+                   const std::function<std::filesystem::path(const std::string&)>& name) {
+  const FilmState* state = r.state.layers.empty() ? nullptr : &r.state;
+  write_image(out, r.image, r.metadata, args.exposure, false, state);
+  if (!args.preview.empty()) write_image(name(args.preview), r.image, {}, args.exposure);
+  if (!args.deep.empty() && !r.deep.offsets.empty()) write_deep_exr(name(args.deep), r.deep, r.metadata);
+}
+
+int run_render(RenderArgs args) {
+  if (!args.resume.empty() && args.output.empty()) args.output = args.resume;
+  if (args.output.empty()) throw Error("--output is required");
+  check_output_names(args);
+  const std::filesystem::path out(args.output);
   RenderOptions options;
-  options.spp = args.spp;
+  FilmState state;
+  std::optional<Scene> resumed;
+  if (!args.resume.empty()) {
+    resumed.emplace(resume_scene(args, &state, &options.spp));
+    options.resume = &state;
+  } else {
+    options.spp = args.spp;
+  }
+  const Scene scene = resumed              ? std::move(*resumed)
+                      : args.scene.empty() ? builtin_demo_scene()
+                                           : load_scene(args.scene);
   options.seed = args.seed;
   options.integrator = args.integrator;
   if (args.layers_given) options.layers = args.layers;
   if (!args.deep.empty()) options.deep_samples = args.deep_samples;
   options.threads = args.threads;
+  options.time_limit = args.time_limit;
   options.cancel = &g_cancel;
-  ProgressBar bar(fmt::format("nimbus: {}", args.scene.empty() ? "demo" : args.scene),
-                  !args.quiet && stderr_is_terminal());
+  const std::string label = !args.resume.empty() ? args.resume : args.scene.empty() ? "demo" : args.scene;
+  ProgressBar bar(fmt::format("nimbus: {}", label), !args.quiet && stderr_is_terminal());
   options.progress = [&bar](int64_t done, int64_t total, int64_t samples) {
     bar.update(done, total, samples);
   };
@@ -95,19 +158,24 @@ int run_render(const RenderArgs& args) {
 
   if (result.nonfinite_samples > 0)
     fmt::print(stderr, "nimbus: warning: {} non-finite samples were dropped\n", result.nonfinite_samples);
-  if (result.partial) {
-    const auto target = partial_name(out);
-    write_image(target, result.image, result.metadata, args.exposure);
-    if (!args.preview.empty()) write_image(partial_name(args.preview), result.image, {}, args.exposure);
-    if (!args.deep.empty()) write_deep_exr(partial_name(args.deep), result.deep, result.metadata);
-    fmt::print(stderr, "nimbus: interrupted ({}): partial image ({} of {} tiles) written to {}\n",
-               g_signal.load() == SIGTERM ? "SIGTERM" : "SIGINT", result.tiles_done, result.tiles_total,
-               target.string());
+  const char* signal = g_signal.load() == SIGTERM ? "SIGTERM" : "SIGINT";
+  if (result.partial && result.spp == 0) {
+    fmt::print(stderr, "nimbus: interrupted ({}) before the first pass ended: nothing written\n", signal);
     return kExitFailure;
   }
-  write_image(out, result.image, result.metadata, args.exposure);
-  if (!args.preview.empty()) write_image(args.preview, result.image, {}, args.exposure);
-  if (!args.deep.empty()) write_deep_exr(args.deep, result.deep, result.metadata);
+  if (result.partial) {
+    const auto target = partial_name(out);
+    write_outputs(args, result, target, [](const std::string& p) { return partial_name(p); });
+    fmt::print(stderr,
+               "nimbus: interrupted ({}) at {} of {} spp: image written to {} (continue it with "
+               "`nimbus render --resume {} -o {}`)\n",
+               signal, result.spp, result.spp_requested, target.string(), target.string(), out.string());
+    return kExitFailure;
+  }
+  write_outputs(args, result, out, [](const std::string& p) { return std::filesystem::path(p); });
+  if (result.time_limited)
+    fmt::print(stderr, "nimbus: time limit of {} s reached at {} of {} spp\n", args.time_limit, result.spp,
+               result.spp_requested);
   if (!args.quiet) {
     fmt::print(stderr, "nimbus: {} {}x{} {} spp in {:.2f}s -> {}\n", result.integrator, result.image.width,
                result.image.height, result.spp, result.seconds, out.string());
@@ -122,8 +190,8 @@ void add_render_command(CLI::App& app, Action& action) {
   auto* cmd = app.add_subcommand("render", "Render a scene file (or the built-in demo) to EXR or PNG");
   cmd->add_option("scene", args->scene, "Scene JSON file (omit for the built-in demo)");
   cmd->add_option("-o,--output", args->output,
-                  "Output image: .exr (linear float premultiplied RGBA and layers) or .png (sRGB preview)")
-      ->required();
+                  "Output image: .exr (linear float premultiplied RGBA and layers) or .png (sRGB preview); "
+                  "with --resume, the resumed file by default");
   cmd->add_option("--preview", args->preview, "Also write an sRGB PNG preview of the same render");
   cmd->add_option("--spp", args->spp, "Samples per pixel (overrides the scene)")
       ->check(CLI::Range(1, kMaxSpp));
@@ -146,6 +214,12 @@ void add_render_command(CLI::App& app, Action& action) {
       ->needs(deep);
   cmd->add_option("--exposure", args->exposure, "Exposure in stops for PNG output")
       ->check(CLI::Range(-64.0, 64.0));
+  cmd->add_option("--time", args->time_limit,
+                  "Time budget in seconds, set-up included: whole passes (1, 2, 4, ... spp) while they fit")
+      ->check(CLI::Range(0.0, 1e8));
+  cmd->add_option("--resume", args->resume,
+                  "Continue this EXR (a partial or finished nimbus render) to more samples (--spp, default "
+                  "the spp it asked for); the scene comes from its header. Bit-identical to one render");
   cmd->add_flag("-q,--quiet", args->quiet, "No progress bar or summary");
   cmd->callback([args, &action] { action = [args] { return run_render(*args); }; });
 }

@@ -31,14 +31,34 @@ struct Image {  // linear RGB, row-major, row 0 = top, 3 floats per pixel
   const float* pixel(int x, int y) const { return &rgb[(size_t(y) * width + x) * 3]; }
 };
 
+// A render's exact accumulation state: per film layer the double sums of its samples (`channels` per
+// pixel, row-major), and each pixel's sample count. Written beside the image in the EXR (a second part,
+// "nimbus.resume") so that `render --resume` continues it bit for bit (docs/cli.md).
+struct FilmState {
+  struct Layer {
+    std::string name;
+    int channels = 0;
+    std::vector<double> sums;
+  };
+  int width = 0, height = 0;
+  int spp = 0;  // samples per pixel taken
+  std::vector<Layer> layers;
+  std::vector<uint32_t> counts;
+};
+
 // String attributes of an EXR header, e.g. {"nimbus/scene", "{...}"}.
 using ImageMetadata = std::vector<std::pair<std::string, std::string>>;
 
 // R, G, B, then A when the image has alpha, then its further channels (OpenEXR stores them sorted by name).
-void write_exr(const std::filesystem::path& path, const Image& img, const ImageMetadata& meta = {});
+// With a film state: a two-part EXR, the image first (what compositors read) and the state second.
+void write_exr(const std::filesystem::path& path, const Image& img, const ImageMetadata& meta = {},
+               const FilmState* state = nullptr);
 // Reads R, G, B (any pixel type; a missing channel reads as 0), A when present, and the string
 // attributes; further channels are not read.
 Image read_exr(const std::filesystem::path& path, ImageMetadata* meta = nullptr);
+// The film state of an EXR written with one; throws nimbus::Error (naming the file) when it has none or
+// the state is malformed.
+FilmState read_exr_state(const std::filesystem::path& path);
 // 8-bit sRGB (the sRGB transfer function, not a 2.2 gamma) of the RGB scaled by 2^exposure (premultiplied
 // colour: the image over black); values are clamped to [0, 1] and non-finite values written as 0. With
 // with_alpha and an image with alpha: an RGBA PNG with straight (unpremultiplied) colour, for viewers
@@ -47,7 +67,7 @@ void write_png(const std::filesystem::path& path, const Image& img, double expos
                bool with_alpha = false);
 // By extension: .exr or .png (any case); anything else is an error.
 void write_image(const std::filesystem::path& path, const Image& img, const ImageMetadata& meta,
-                 double exposure_stops, bool png_alpha = false);
+                 double exposure_stops, bool png_alpha = false, const FilmState* state = nullptr);
 
 // sRGB encoding of a linear value in [0, 1] (IEC 61966-2-1).
 double srgb_encode(double linear);

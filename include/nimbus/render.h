@@ -24,11 +24,24 @@ struct RenderOptions {
   int deep_samples = 0;
   int threads = 0;  // 0 = all hardware threads
   int tile_size = 16;
-  // Called from worker threads as tiles finish: (tiles done, tiles total, samples so far).
+  // Called from worker threads as tiles finish: (pixel samples done, pixel samples to take, the same
+  // count of samples), counted over all passes of this render.
   std::function<void(int64_t done, int64_t total, int64_t samples)> progress;
-  // Set to true (e.g. from a signal handler) to stop at the next tile.
+  // Set to true (e.g. from a signal handler) to stop: the pass under way is dropped and the image is
+  // the one of the last whole pass (RenderResult::partial).
   const std::atomic<bool>* cancel = nullptr;
+  // > 0: a time budget in seconds, set-up included. The render takes whole passes while they fit (the
+  // first pass is always taken) and ends with the spp reached (RenderResult::time_limited).
+  double time_limit = 0.0;
+  // A film state to continue (render --resume): the samples it holds are kept and the render goes on
+  // from its spp to the requested one. Needs the same scene, seed and film; the result equals, bit for
+  // bit, the render made in one go. Not with a deep image.
+  const FilmState* resume = nullptr;
 };
+
+// The passes of a progressive render: from `done` samples per pixel the next pass goes to twice as many
+// (1, 2, 4, ...), the last one to `spp`. A deep image is made in one pass.
+int next_pass_spp(int done, int spp);
 
 // At most this many deep samples per pixel.
 inline constexpr int kMaxDeepSamples = 1024;
@@ -39,12 +52,15 @@ struct RenderResult {
   // The media's contribution along each camera ray (RenderOptions::deep_samples > 0; empty otherwise):
   // flattened, the RGBA of a transparent film.
   DeepImage deep;
-  bool partial = false;  // cancelled: tiles not rendered are black
-  int64_t tiles_done = 0, tiles_total = 0;
-  int64_t nonfinite_samples = 0;  // NaN/inf samples found and dropped by the film
+  // The exact accumulation state at `spp`, for writing beside the image and resuming (not with deep).
+  FilmState state;
+  bool partial = false;           // cancelled before the requested spp: the image of the last whole pass
+  bool time_limited = false;      // stopped by RenderOptions::time_limit before the requested spp
+  int64_t nonfinite_samples = 0;  // NaN/inf samples found and dropped by the film (in this run)
   double seconds = 0.0;
   std::string integrator;
-  int spp = 0;
+  int spp = 0;            // samples per pixel in the image (every pixel has as many)
+  int spp_requested = 0;  // what the render asked for
   uint64_t seed = 0;
   // The integrator block as rendered: type, spp, seed, max_events and the integrator's own fields with
   // "auto" choices resolved (also in the EXR header as nimbus/integrator_settings).

@@ -1,5 +1,5 @@
 // Image files (nimbus/image.h): EXR read and write (RGB, alpha, layers), sRGB PNG output, both written
-// atomically. Deep EXR: io/deep_exr.cpp.
+// atomically. Deep EXR: io/deep_exr.cpp; the resume state beside the image: io/exr_state.cpp.
 #include "nimbus/image.h"
 
 #include <OpenEXR/ImfChannelList.h>
@@ -15,6 +15,7 @@
 #include <cmath>
 
 #include "io/atomic_file.h"
+#include "io/exr_state.h"
 #include "nimbus/error.h"
 
 namespace nimbus {
@@ -32,7 +33,9 @@ double srgb_encode(double x) {
   return x <= 0.0031308 ? 12.92 * x : 1.055 * std::pow(x, 1.0 / 2.4) - 0.055;
 }
 
-void write_exr(const fs::path& path, const Image& img, const ImageMetadata& meta) {
+namespace {
+
+void check_image(const fs::path& path, const Image& img) {
   const size_t n = size_t(std::max(img.width, 0)) * size_t(std::max(img.height, 0));
   if (img.width <= 0 || img.height <= 0 || img.rgb.size() != n * 3 ||
       (!img.alpha.empty() && img.alpha.size() != n))
@@ -41,27 +44,42 @@ void write_exr(const fs::path& path, const Image& img, const ImageMetadata& meta
     if (c.data.size() != n || c.name.empty() || c.name == "R" || c.name == "G" || c.name == "B" ||
         c.name == "A")
       throw Error(fmt::format("{}: malformed image channel '{}'", path.string(), c.name));
+}
+
+}  // namespace
+
+Imf::Header exr_image_header(const Image& img, const ImageMetadata& meta) {
+  Imf::Header header(img.width, img.height);
+  header.compression() = Imf::ZIP_COMPRESSION;
+  for (const char* c : {"R", "G", "B"}) header.channels().insert(c, Imf::Channel(Imf::FLOAT));
+  if (!img.alpha.empty()) header.channels().insert("A", Imf::Channel(Imf::FLOAT));
+  for (const ImageChannel& c : img.channels) header.channels().insert(c.name, Imf::Channel(Imf::FLOAT));
+  for (const auto& [key, value] : meta) header.insert(key, Imf::StringAttribute(value));
+  return header;
+}
+
+Imf::FrameBuffer exr_image_frame_buffer(const Image& img) {
+  Imf::FrameBuffer fb;
+  char* base = reinterpret_cast<char*>(const_cast<float*>(img.rgb.data()));
+  const size_t xs = 3 * sizeof(float), ys = xs * img.width;
+  fb.insert("R", Imf::Slice(Imf::FLOAT, base, xs, ys));
+  fb.insert("G", Imf::Slice(Imf::FLOAT, base + sizeof(float), xs, ys));
+  fb.insert("B", Imf::Slice(Imf::FLOAT, base + 2 * sizeof(float), xs, ys));
+  auto plane = [&](const std::string& name, const std::vector<float>& data) {
+    char* p = reinterpret_cast<char*>(const_cast<float*>(data.data()));
+    fb.insert(name, Imf::Slice(Imf::FLOAT, p, sizeof(float), sizeof(float) * img.width));
+  };
+  if (!img.alpha.empty()) plane("A", img.alpha);
+  for (const ImageChannel& c : img.channels) plane(c.name, c.data);
+  return fb;
+}
+
+void write_exr(const fs::path& path, const Image& img, const ImageMetadata& meta, const FilmState* state) {
+  check_image(path, img);
+  if (state) return write_exr_with_state(path, img, meta, *state);
   atomic_write(path, [&](const fs::path& tmp) {
-    Imf::Header header(img.width, img.height);
-    header.compression() = Imf::ZIP_COMPRESSION;
-    for (const char* c : {"R", "G", "B"}) header.channels().insert(c, Imf::Channel(Imf::FLOAT));
-    if (!img.alpha.empty()) header.channels().insert("A", Imf::Channel(Imf::FLOAT));
-    for (const ImageChannel& c : img.channels) header.channels().insert(c.name, Imf::Channel(Imf::FLOAT));
-    for (const auto& [key, value] : meta) header.insert(key, Imf::StringAttribute(value));
-    Imf::OutputFile file(tmp.c_str(), header);
-    Imf::FrameBuffer fb;
-    char* base = reinterpret_cast<char*>(const_cast<float*>(img.rgb.data()));
-    const size_t xs = 3 * sizeof(float), ys = xs * img.width;
-    fb.insert("R", Imf::Slice(Imf::FLOAT, base, xs, ys));
-    fb.insert("G", Imf::Slice(Imf::FLOAT, base + sizeof(float), xs, ys));
-    fb.insert("B", Imf::Slice(Imf::FLOAT, base + 2 * sizeof(float), xs, ys));
-    auto plane = [&](const std::string& name, const std::vector<float>& data) {
-      char* p = reinterpret_cast<char*>(const_cast<float*>(data.data()));
-      fb.insert(name, Imf::Slice(Imf::FLOAT, p, sizeof(float), sizeof(float) * img.width));
-    };
-    if (!img.alpha.empty()) plane("A", img.alpha);
-    for (const ImageChannel& c : img.channels) plane(c.name, c.data);
-    file.setFrameBuffer(fb);
+    Imf::OutputFile file(tmp.c_str(), exr_image_header(img, meta));
+    file.setFrameBuffer(exr_image_frame_buffer(img));
     file.writePixels(img.height);
   });
 }
@@ -139,10 +157,10 @@ void write_png(const fs::path& path, const Image& img, double exposure_stops, bo
 }
 
 void write_image(const fs::path& path, const Image& img, const ImageMetadata& meta, double exposure_stops,
-                 bool png_alpha) {
+                 bool png_alpha, const FilmState* state) {
   std::string ext = path.extension().string();
   for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
-  if (ext == ".exr") return write_exr(path, img, meta);
+  if (ext == ".exr") return write_exr(path, img, meta, state);
   if (ext == ".png") return write_png(path, img, exposure_stops, png_alpha);
   throw Error(fmt::format("{}: unsupported output extension '{}' (use .exr or .png)", path.string(), ext));
 }

@@ -1,5 +1,9 @@
 #include "render/film.h"
 
+#include <fmt/format.h>
+
+#include <algorithm>
+
 #include "nimbus/error.h"
 
 namespace nimbus {
@@ -33,6 +37,36 @@ std::vector<float> Film::resolve_layer(int layer) const {
     }
   }
   return out;
+}
+
+FilmState Film::state(int spp) const {
+  FilmState st;
+  st.width = width_;
+  st.height = height_;
+  st.spp = spp;
+  for (const Layer& l : layers_) st.layers.push_back({l.name, l.channels, l.sum});
+  st.counts = count_;
+  return st;
+}
+
+void Film::restore(const FilmState& st) {
+  if (st.width != width_ || st.height != height_)
+    throw Error(fmt::format("resume data: the image is {}x{}, the render {}x{}", st.width, st.height, width_,
+                            height_));
+  if (st.counts.size() != count_.size()) throw Error("resume data: wrong number of sample counts");
+  for (const Layer& l : layers_) {
+    const auto it = std::find_if(st.layers.begin(), st.layers.end(),
+                                 [&](const FilmState::Layer& s) { return s.name == l.name; });
+    if (it == st.layers.end() || it->channels != l.channels || it->sums.size() != l.sum.size())
+      throw Error(fmt::format("resume data: no film layer '{}' of {} channels", l.name, l.channels));
+  }
+  if (st.layers.size() != layers_.size())
+    throw Error(
+        fmt::format("resume data: {} film layers, the render has {}", st.layers.size(), layers_.size()));
+  for (Layer& l : layers_)
+    for (const FilmState::Layer& s : st.layers)
+      if (s.name == l.name) l.sum = s.sums;
+  count_ = st.counts;
 }
 
 Image Film::resolve() const {

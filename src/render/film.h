@@ -49,6 +49,11 @@ class Film {
   // Any layer's pixel means, `channels` floats per pixel, row 0 at the top.
   std::vector<float> resolve_layer(int layer) const;
 
+  // The exact state (every layer's sums, the sample counts), to stop a render and resume it bit for bit.
+  FilmState state(int spp) const;
+  // Restores a state taken from a film with the same size and layers; throws nimbus::Error otherwise.
+  void restore(const FilmState& state);
+
  private:
   struct Layer {
     std::string name;

@@ -1,7 +1,9 @@
 // The driver: resolves the render's settings, builds the scene context and the integrator through the
-// registry, makes the camera rays and adds their radiance to the film, tile by tile over oneTBB. Every
-// sample is seeded from (seed, pixel, sample index), so the image is bit-identical for any thread
-// count; progress and cancellation go through callbacks.
+// registry, makes the camera rays and adds their radiance to the film, in passes over the whole image
+// (1, 2, 4, ... spp), each tile by tile over oneTBB. Every sample is seeded from (seed, pixel, sample
+// index) and a pixel's samples are added in order into double sums, so the image is bit-identical for
+// any thread count and for any split into passes: a render stopped (cancel, time budget) and resumed
+// from its film state equals the render made in one go. Progress and cancellation go through callbacks.
 #include "nimbus/render.h"
 
 #include <fmt/format.h>
@@ -11,6 +13,8 @@
 
 #include <chrono>
 #include <cmath>
+#include <filesystem>
+#include <functional>
 #include <memory>
 #include <optional>
 
@@ -43,6 +47,8 @@ IntegratorSettings resolve_settings(const Scene& scene, const RenderOptions& opt
   if (options.threads < 0) throw Error("threads must be >= 0");
   if (options.tile_size < 1) throw Error("tile size must be >= 1");
   if (options.layers) check_film_layers(*options.layers);  // before any precomputation
+  if (!(options.time_limit >= 0.0 && options.time_limit < 1e9)) throw Error("time limit must be >= 0 s");
+  if (options.resume && options.deep_samples > 0) throw Error("a deep image cannot be resumed");
   if (options.deep_samples < 0 || options.deep_samples > kMaxDeepSamples)
     throw Error(fmt::format("deep samples must be between 1 and {} (0: no deep image)", kMaxDeepSamples));
   return settings;
@@ -71,15 +77,17 @@ struct PixelTargets {
 // Samples of pixel (x, y) into the film. Positions in the pixel: the R2 sequence (Roberts 2018), shifted
 // by a random offset per pixel (a Cranley-Patterson rotation, so each sample is still uniform over the
 // pixel and the estimate unbiased); its samples are spread evenly for every spp, which halves edge noise
-// at a few spp. Returns the number of non-finite samples (dropped).
+// at a few spp. Samples [s0, s1) of the pixel, added in order (a deep pixel takes all its samples in one
+// call). Returns the number of non-finite samples (dropped).
 int64_t render_pixel(const Integrator& integrator, const PinholeCamera& camera,
-                     const IntegratorSettings& settings, int x, int y, const PixelTargets& to) {
+                     const IntegratorSettings& settings, int x, int y, int s0, int s1,
+                     const PixelTargets& to) {
   Rng shift = Rng::for_sample(settings.seed, uint32_t(x), uint32_t(y), ~uint64_t(0));
   const double ux = shift.uniform(), uy = shift.uniform();
   int64_t bad = 0;
   thread_local std::vector<DeepSegment> segments, sample_segments;
   segments.clear();
-  for (int s = 0; s < settings.spp; ++s) {
+  for (int s = s0; s < s1; ++s) {
     Rng rng = Rng::for_sample(settings.seed, uint32_t(x), uint32_t(y), uint64_t(s));
     double jx = ux + s * kR2a1, jy = uy + s * kR2a2;
     jx -= std::floor(jx);
@@ -117,10 +125,94 @@ DeepImage assemble_deep(int width, int height, std::vector<std::vector<DeepSampl
   return deep;
 }
 
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+// What every pass needs: the integrator and camera, the film's targets, the stop test, and the counts
+// that progress reports over all passes.
+struct PassContext {
+  const Integrator& integrator;
+  const PinholeCamera& camera;
+  const IntegratorSettings& settings;
+  const RenderOptions& options;
+  const PixelTargets& targets;
+  int width = 0, height = 0;
+  std::function<bool()> stop;    // cancelled, or past the time budget
+  std::atomic<int64_t> done{0};  // pixel samples finished (over all passes)
+  int64_t total = 0;             // pixel samples to take
+  int64_t nonfinite = 0;         // in whole passes
+};
+
+// Samples [s0, s1) of every pixel, tile by tile over oneTBB. Returns false when stopped part-way (the
+// film then holds part of the pass).
+bool render_pass(PassContext& pc, tbb::task_arena& arena, int s0, int s1) {
+  const int ts = pc.options.tile_size, W = pc.width, H = pc.height;
+  const int tiles_x = (W + ts - 1) / ts, tiles_y = (H + ts - 1) / ts;
+  std::atomic<bool> stopped{false};
+  std::atomic<int64_t> bad{0};
+  auto render_tile = [&](int64_t tile) {
+    const int x0 = int(tile % tiles_x) * ts, y0 = int(tile / tiles_x) * ts;
+    const int x1 = std::min(x0 + ts, W), y1 = std::min(y0 + ts, H);
+    int64_t tile_bad = 0;
+    for (int y = y0; y < y1; ++y) {
+      // Stay responsive inside long tiles: the pass is abandoned.
+      if (stopped.load(std::memory_order_relaxed) || pc.stop()) {
+        stopped = true;
+        return;
+      }
+      for (int x = x0; x < x1; ++x)
+        tile_bad += render_pixel(pc.integrator, pc.camera, pc.settings, x, y, s0, s1, pc.targets);
+    }
+    bad += tile_bad;
+    const int64_t done = pc.done += int64_t(x1 - x0) * (y1 - y0) * (s1 - s0);
+    if (pc.options.progress) pc.options.progress(done, pc.total, done);
+  };
+  arena.execute([&] {
+    tbb::parallel_for(tbb::blocked_range<int64_t>(0, int64_t(tiles_x) * tiles_y, 1),
+                      [&](const tbb::blocked_range<int64_t>& r) {
+                        for (int64_t t = r.begin(); t != r.end(); ++t) render_tile(t);
+                      });
+  });
+  if (stopped) return false;
+  pc.nonfinite += bad;
+  return true;
+}
+
+// The header's record of how the image was made: the scene as rendered, with its integrator block
+// replaced by the resolved one (overrides applied, "auto" choices made), and the spp reached.
+ImageMetadata render_metadata(const Scene& scene, const RenderResult& result, const FilmSettings& film) {
+  nlohmann::json rendered = scene.source.is_object() ? scene.source : nlohmann::json::object();
+  rendered["integrator"] = result.settings;
+  if (film.transparent || !film.layers.empty() || rendered.contains("film"))
+    rendered["film"] = {{"transparent", film.transparent}, {"layers", film.layers}};
+  std::error_code ec;
+  const std::filesystem::path file =
+      scene.file.empty() ? scene.file : std::filesystem::absolute(scene.file, ec);
+  return {
+      {"nimbus/version", "0.1.0"},
+      {"nimbus/integrator", result.integrator},
+      {"nimbus/spp", std::to_string(result.spp)},
+      {"nimbus/spp_requested", std::to_string(result.spp_requested)},
+      {"nimbus/seed", std::to_string(result.seed)},
+      {"nimbus/max_events", result.settings.value("max_events", nlohmann::json(0)).dump()},
+      {"nimbus/integrator_settings", result.settings.dump()},
+      {"nimbus/scene_file", ec ? scene.file.string() : file.string()},
+      {"nimbus/scene", rendered.dump()},
+      {"nimbus/partial", result.partial ? "true" : "false"},
+      {"nimbus/time_limited", result.time_limited ? "true" : "false"},
+      {"nimbus/render_seconds", fmt::format("{:.3f}", result.seconds)},
+  };
+}
+
 }  // namespace
 
+int next_pass_spp(int done, int spp) {
+  return std::min(spp, done < 1 ? 1 : (done > spp / 2 ? spp : 2 * done));
+}
+
 RenderResult render(const Scene& scene, const RenderOptions& options) {
-  const auto start = std::chrono::steady_clock::now();
+  const auto start = Clock::now();
   const IntegratorSettings settings = resolve_settings(scene, options);
 
   // Every parallel part, the integrator's precomputation (shadow maps, photon grids) included, runs in
@@ -136,73 +228,67 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
 
   RenderResult result;
   result.integrator = settings.type;
-  result.spp = settings.spp;
+  result.spp_requested = settings.spp;
   result.seed = settings.seed;
-  const int W = scene.camera.width, H = scene.camera.height, ts = options.tile_size;
+  const int W = scene.camera.width, H = scene.camera.height;
   Film film(W, H);
   FilmSettings film_settings = scene.film;
   if (options.layers) film_settings.layers = *options.layers;
   const FilmLayers layers(film, film_settings, context->has_environment);
+  int done = 0;
+  if (options.resume) {
+    film.restore(*options.resume);
+    done = options.resume->spp;
+    if (done > settings.spp)
+      throw Error(
+          fmt::format("resume: the image has {} spp, more than the {} asked for", done, settings.spp));
+  }
   std::vector<std::vector<DeepSample>> deep_pixels(options.deep_samples > 0 ? size_t(W) * size_t(H) : 0);
   const PixelTargets targets{film, layers, options.deep_samples, &deep_pixels};
-  const int tiles_x = (W + ts - 1) / ts, tiles_y = (H + ts - 1) / ts;
-  result.tiles_total = int64_t(tiles_x) * tiles_y;
 
-  std::atomic<int64_t> tiles_done{0}, nonfinite{0}, samples{0};
-  std::atomic<bool> stopped{false};
+  bool first = true;
   auto cancelled = [&] { return options.cancel && options.cancel->load(std::memory_order_relaxed); };
-  auto render_tile = [&](int64_t tile) {
-    const int x0 = int(tile % tiles_x) * ts, y0 = int(tile / tiles_x) * ts;
-    const int x1 = std::min(x0 + ts, W), y1 = std::min(y0 + ts, H);
-    int64_t bad = 0;
-    for (int y = y0; y < y1; ++y) {
-      // Stay responsive inside long tiles: abandon the tile (it counts as not done).
-      if (cancelled()) {
-        stopped = true;
-        nonfinite += bad;
-        return;
+  auto over_time = [&] {
+    return options.time_limit > 0.0 && !first && seconds_since(start) > options.time_limit;
+  };
+  PassContext pc{*integrator, context->camera,
+                 settings,    options,
+                 targets,     W,
+                 H,           [&] { return cancelled() || over_time(); }};
+  pc.total = int64_t(W) * H * (settings.spp - done);
+  const bool stoppable = options.cancel || options.time_limit > 0.0;
+  double seconds_per_spp = 0.0;
+  while (done < settings.spp) {
+    int next = options.deep_samples > 0 ? settings.spp : next_pass_spp(done, settings.spp);
+    if (!first && options.time_limit > 0.0) {  // only passes that fit the budget, as measured so far
+      const double fit = 0.95 * (options.time_limit - seconds_since(start)) / seconds_per_spp;
+      if (!(fit >= 1.0)) {
+        result.time_limited = true;
+        break;
       }
-      for (int x = x0; x < x1; ++x)
-        bad += render_pixel(*integrator, context->camera, settings, x, y, targets);
+      next = int(std::min<double>(next, done + std::floor(fit)));
     }
-    nonfinite += bad;
-    const int64_t done = ++tiles_done;
-    const int64_t total_samples = samples += int64_t(x1 - x0) * (y1 - y0) * settings.spp;
-    if (options.progress) options.progress(done, result.tiles_total, total_samples);
-  };
+    const FilmState before = stoppable ? film.state(done) : FilmState{};
+    const auto pass_start = Clock::now();
+    if (!render_pass(pc, arena, done, next)) {
+      film.restore(before);  // the image of the last whole pass
+      (cancelled() ? result.partial : result.time_limited) = true;
+      break;
+    }
+    seconds_per_spp = seconds_since(pass_start) / (next - done);
+    done = next;
+    first = false;
+  }
+  if (done < settings.spp && !result.time_limited) result.partial = true;
 
-  arena.execute([&] {
-    tbb::parallel_for(tbb::blocked_range<int64_t>(0, result.tiles_total, 1),
-                      [&](const tbb::blocked_range<int64_t>& r) {
-                        for (int64_t t = r.begin(); t != r.end(); ++t) render_tile(t);
-                      });
-  });
-
+  result.spp = done;
   result.image = layers.resolve(film);
-  if (options.deep_samples > 0) result.deep = assemble_deep(W, H, deep_pixels);
-  result.tiles_done = tiles_done;
-  result.partial = stopped || tiles_done < result.tiles_total;
-  result.nonfinite_samples = nonfinite;
-  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  // The header says exactly how the image was made: the scene as rendered, with its integrator block
-  // replaced by the resolved one (overrides applied, "auto" choices made).
+  if (options.deep_samples > 0 && done == settings.spp) result.deep = assemble_deep(W, H, deep_pixels);
+  if (options.deep_samples == 0) result.state = film.state(done);
+  result.nonfinite_samples = pc.nonfinite;
+  result.seconds = seconds_since(start);
   result.settings = resolved_block(settings, *integrator);
-  nlohmann::json rendered = scene.source.is_object() ? scene.source : nlohmann::json::object();
-  rendered["integrator"] = result.settings;
-  if (film_settings.transparent || !film_settings.layers.empty() || rendered.contains("film"))
-    rendered["film"] = {{"transparent", film_settings.transparent}, {"layers", film_settings.layers}};
-  result.metadata = {
-      {"nimbus/version", "0.1.0"},
-      {"nimbus/integrator", settings.type},
-      {"nimbus/spp", std::to_string(settings.spp)},
-      {"nimbus/seed", std::to_string(settings.seed)},
-      {"nimbus/max_events", std::to_string(settings.max_events)},
-      {"nimbus/integrator_settings", result.settings.dump()},
-      {"nimbus/scene_file", scene.file.string()},
-      {"nimbus/scene", rendered.dump()},
-      {"nimbus/partial", result.partial ? "true" : "false"},
-      {"nimbus/render_seconds", fmt::format("{:.3f}", result.seconds)},
-  };
+  result.metadata = render_metadata(scene, result, film_settings);
   return result;
 }
 

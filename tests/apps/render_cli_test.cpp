@@ -1,11 +1,12 @@
 // nimbus render end to end: outputs and their headers, failed runs leave existing files alone, and
-// SIGINT writes a flagged partial image under its own name.
+// SIGINT writes a flagged partial image under its own name; --resume and --time.
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <chrono>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <thread>
@@ -84,7 +85,7 @@ TEST(RenderCli, FailedRunKeepsTheExistingOutput) {
 TEST(RenderCli, SigintWritesAFlaggedPartialImage) {
   const test::ScratchDir scratch("render_cli_sigint");
   const fs::path& dir = scratch.path;
-  write_scene(dir / "s.json", 256, 4096);  // minutes of work: it will be interrupted
+  write_scene(dir / "s.json", 48, 1 << 20);  // hours of work: it will be interrupted
   std::ofstream(dir / "out.exr") << "precious";
   const pid_t pid = fork();
   ASSERT_GE(pid, 0);
@@ -102,11 +103,67 @@ TEST(RenderCli, SigintWritesAFlaggedPartialImage) {
   ImageMetadata meta;
   const Image partial = read_exr(dir / "out.partial.exr", &meta);
   EXPECT_EQ(meta_value(meta, "nimbus/partial"), "true");
-  EXPECT_EQ(partial.width, 256);
+  EXPECT_EQ(partial.width, 48);
+  // A whole image at the spp of the last whole pass (a power of two), not a black part.
+  const int spp = std::stoi(meta_value(meta, "nimbus/spp"));
+  EXPECT_GE(spp, 1);
+  EXPECT_EQ(spp & (spp - 1), 0);
+  EXPECT_EQ(read_exr_state(dir / "out.partial.exr").spp, spp);
+  int black = 0;  // the environment lights every pixel of a whole pass
+  for (int y = 0; y < partial.height; ++y)
+    for (int x = 0; x < partial.width; ++x) black += partial.pixel(x, y)[2] == 0.0f;
+  EXPECT_EQ(black, 0);
   std::ifstream in(dir / "out.exr");
   std::string content;
   in >> content;
   EXPECT_EQ(content, "precious");
+}
+
+TEST(RenderCli, ResumeEqualsOneRenderBitForBit) {
+  const test::ScratchDir scratch("render_cli_resume");
+  const fs::path& dir = scratch.path;
+  write_scene(dir / "s.json", 12, 6);
+  const std::string s = (dir / "s.json").string() + " --quiet --layers depth,direct ";
+  ASSERT_EQ(run("render " + s + "-o " + (dir / "one.exr").string()), 0);
+  ASSERT_EQ(run("render " + s + "-o " + (dir / "two.exr").string() + " --spp 3 --threads 1"), 0);
+  // Continued in place, on two threads, to 6 spp.
+  ASSERT_EQ(run("render --quiet --resume " + (dir / "two.exr").string() + " --threads 2 --spp 6"), 0);
+  ImageMetadata meta;
+  const Image one = read_exr(dir / "one.exr"), two = read_exr(dir / "two.exr", &meta);
+  EXPECT_EQ(meta_value(meta, "nimbus/spp"), "6");
+  ASSERT_EQ(one.rgb.size(), two.rgb.size());
+  EXPECT_EQ(0, std::memcmp(one.rgb.data(), two.rgb.data(), one.rgb.size() * sizeof(float)));
+  EXPECT_EQ(0, std::memcmp(one.alpha.data(), two.alpha.data(), one.alpha.size() * sizeof(float)));
+  const FilmState a = read_exr_state(dir / "one.exr"), b = read_exr_state(dir / "two.exr");
+  ASSERT_EQ(a.layers.size(), b.layers.size());
+  for (size_t l = 0; l < a.layers.size(); ++l)
+    EXPECT_EQ(a.layers[l].sums, b.layers[l].sums) << a.layers[l].name;
+  // Nothing to add, a scene beside --resume, or a file without a state: exit 2, the file untouched.
+  const auto before = fs::last_write_time(dir / "two.exr");
+  EXPECT_EQ(run("render --quiet --resume " + (dir / "two.exr").string() + " 2>/dev/null"), 2);
+  EXPECT_EQ(run("render " + s + "--resume " + (dir / "two.exr").string() + " --spp 9 2>/dev/null"), 2);
+  EXPECT_EQ(fs::last_write_time(dir / "two.exr"), before);
+  write_exr(dir / "plain.exr", one);
+  EXPECT_EQ(run("render --quiet --resume " + (dir / "plain.exr").string() + " --spp 9 -o " +
+                (dir / "x.exr").string() + " 2>/dev/null"),
+            2);
+  EXPECT_FALSE(fs::exists(dir / "x.exr"));
+}
+
+TEST(RenderCli, TimeLimitGivesAWholeImageAtFewerSamples) {
+  const test::ScratchDir scratch("render_cli_time");
+  const fs::path& dir = scratch.path;
+  write_scene(dir / "s.json", 16, 1 << 20);
+  ASSERT_EQ(run("render " + (dir / "s.json").string() + " -o " + (dir / "t.exr").string() +
+                " --quiet --time 0.5 --threads 1 2>/dev/null"),
+            0);
+  ImageMetadata meta;
+  read_exr(dir / "t.exr", &meta);
+  EXPECT_EQ(meta_value(meta, "nimbus/time_limited"), "true");
+  EXPECT_EQ(meta_value(meta, "nimbus/partial"), "false");
+  const int spp = std::stoi(meta_value(meta, "nimbus/spp"));
+  EXPECT_GE(spp, 1);
+  EXPECT_LT(spp, 1 << 20);
 }
 
 TEST(RenderCli, ConvertWritesAPngAndRejectsBadInput) {
