@@ -32,8 +32,8 @@ struct Image {  // linear RGB, row-major, row 0 = top, 3 floats per pixel
 };
 
 // A render's exact accumulation state: per film layer the double sums of its samples (`channels` per
-// pixel, row-major), and each pixel's sample count. Written beside the image in the EXR (a second part,
-// "nimbus.resume") so that `render --resume` continues it bit for bit (docs/cli.md).
+// pixel, row-major), and each pixel's sample count. Written beside the image in the EXR (UINT channels
+// nimbus_resume_*) so that `render --resume` continues it bit for bit (docs/cli.md).
 struct FilmState {
   struct Layer {
     std::string name;
@@ -50,7 +50,7 @@ struct FilmState {
 using ImageMetadata = std::vector<std::pair<std::string, std::string>>;
 
 // R, G, B, then A when the image has alpha, then its further channels (OpenEXR stores them sorted by name).
-// With a film state: a two-part EXR, the image first (what compositors read) and the state second.
+// With a film state: its channels too (io/exr_state.cpp).
 void write_exr(const std::filesystem::path& path, const Image& img, const ImageMetadata& meta = {},
                const FilmState* state = nullptr);
 // Reads R, G, B (any pixel type; a missing channel reads as 0), A when present, and the string

@@ -1,4 +1,4 @@
-// The film state in an EXR (nimbus/image.h: FilmState): a second part, "nimbus.resume", beside the image.
+// The film state in an EXR (nimbus/image.h: FilmState): UINT channels nimbus_resume_* beside the image.
 #pragma once
 
 #include <OpenEXR/ImfFrameBuffer.h>
@@ -14,7 +14,7 @@ namespace nimbus {
 Imf::Header exr_image_header(const Image& img, const ImageMetadata& meta);
 Imf::FrameBuffer exr_image_frame_buffer(const Image& img);
 
-// Writes the image (part 0, as write_exr) and the state (part 1) atomically; `img` is checked already.
+// Writes the image (as write_exr) and the state's channels atomically; `img` is checked already.
 void write_exr_with_state(const std::filesystem::path& path, const Image& img, const ImageMetadata& meta,
                           const FilmState& state);
 
