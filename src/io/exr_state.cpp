@@ -109,6 +109,9 @@ FilmState read_state(const fs::path& path) {
   st.width = dw.max.x + 1;
   st.height = dw.max.y + 1;
   st.spp = spp->value();
+  if (st.width < 1 || st.height < 1 || st.width > (1 << 16) || st.height > (1 << 16) ||
+      size_t(st.width) * size_t(st.height) > (size_t(1) << 28))
+    throw Error("malformed resume state (image size)");
   const size_t n = size_t(st.width) * size_t(st.height);
   std::map<std::string, int> channels;  // layer -> channels, from the PREFIX.LAYER.C.hi names
   const std::string prefix = kPrefix;
