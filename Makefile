@@ -1,5 +1,6 @@
 # nimbus: the two commands of the README.
-#   make demo   installs missing Debian packages, builds, renders the built-in scene to out/demo.{exr,png}
+#   make demo   installs missing Debian packages, builds, renders the built-in scene with mfs to
+#               out/demo.{exr,png} and with pathtrace in the same time to out/demo_pathtrace.{exr,png}
 #   make test   installs missing Debian packages, builds, runs the whole suite through ctest
 # Also: make (build only), make test-fast (no statistical tests), make asan (sanitizer build + fast tests),
 # make fuzz-smoke (libFuzzer targets, 60 s each), make fuzz FUZZ_SECONDS=N (N s each): docs/reliability.md.
@@ -25,9 +26,7 @@ build: configure
 
 demo: deps
 	@$(MAKE) --no-print-directory build
-	@mkdir -p out
-	$(BUILD)/bin/nimbus render -o out/demo.exr --preview out/demo.png
-	@echo "nimbus: demo written to out/demo.exr and out/demo.png"
+	@./scripts/demo.sh $(BUILD) out
 
 test: deps
 	@$(MAKE) --no-print-directory build
