@@ -42,6 +42,7 @@ std::vector<std::string> split_names(const std::string& list) {
 }
 
 int run_beam(const BeamArgs& a) {
+  if (!a.out.empty() && a.out != "-") check_output_path(a.out, "--output");
   BeamSettings s;
   s.phase = parse_phase_spec(a.phase);
   s.albedo = a.albedo;

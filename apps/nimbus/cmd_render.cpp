@@ -60,6 +60,9 @@ std::filesystem::path partial_name(const std::filesystem::path& out) {
 }
 
 void check_output_names(const RenderArgs& args) {
+  check_output_path(args.output, "--output");
+  if (!args.preview.empty()) check_output_path(args.preview, "--preview");
+  if (!args.deep.empty()) check_output_path(args.deep, "--deep");
   const std::filesystem::path out(args.output);
   const std::string ext = lower_extension(out);
   if (ext != ".exr" && ext != ".png")
@@ -70,10 +73,6 @@ void check_output_names(const RenderArgs& args) {
     throw Error(fmt::format("--layers: {}: layers need an .exr output", args.output));
   if (!args.deep.empty() && lower_extension(args.deep) != ".exr")
     throw Error(fmt::format("--deep: {}: the deep image must be an .exr file", args.deep));
-  const std::filesystem::path dir = out.has_parent_path() ? out.parent_path() : std::filesystem::path(".");
-  std::error_code ec;
-  if (!std::filesystem::is_directory(dir, ec))
-    throw Error(fmt::format("{}: output directory '{}' does not exist", args.output, dir.string()));
 }
 
 std::string meta_value(const ImageMetadata& meta, const std::string& key, const std::string& file) {

@@ -31,6 +31,7 @@ struct SlabArgs {
 };
 
 int run_slab(const SlabArgs& a) {
+  if (!a.csv_path.empty() && a.csv_path != "-") check_output_path(a.csv_path, "--csv");
   if (!(a.mu_s >= 0.0) || !std::isfinite(a.mu_s))
     throw Error(fmt::format("--mu-s must be >= 0 (got {})", a.mu_s));
   if (!(a.mu_a >= 0.0) || !std::isfinite(a.mu_a))

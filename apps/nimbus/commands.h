@@ -5,6 +5,7 @@
 
 #include <CLI/CLI.hpp>
 #include <functional>
+#include <string>
 
 namespace nimbus::cli {
 
@@ -19,6 +20,10 @@ void add_info_command(CLI::App& app, Action& action);
 void add_convert_command(CLI::App& app, Action& action);
 void add_beam_command(CLI::App& app, Action& action);
 void add_slab_command(CLI::App& app, Action& action);
+
+// Throws nimbus::Error (naming `option`) unless `path` names a file in an existing folder: checked before
+// the work, so that a long run never ends in a path it cannot write.
+void check_output_path(const std::string& path, const std::string& option);
 
 // Exit codes.
 inline constexpr int kExitOk = 0;

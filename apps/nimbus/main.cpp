@@ -15,8 +15,9 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    const int rc = app.exit(e);
-    return rc == 0 ? kExitOk : kExitBadInput;
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
+    fmt::print(stderr, "nimbus: error: {}\nRun with --help for more information.\n", e.what());
+    return kExitBadInput;
   }
   try {
     return action ? action() : kExitOk;

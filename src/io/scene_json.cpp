@@ -1,6 +1,7 @@
 // Scene JSON: parsing and validation (docs/scene-format.md is the user-facing description).
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -188,9 +189,26 @@ Scene load_scene(const std::filesystem::path& file) {
   if (!in) throw Error(fmt::format("{}: cannot be opened for reading", name));
   std::ostringstream text;
   text << in.rdbuf();
+  const std::string ext = file.extension().string();
+  if (ext == ".vdb" || ext == ".nvdb")
+    throw Error(
+        fmt::format("{}: a volume, not a scene: a scene is a JSON file that names its volumes "
+                    "(docs/scene-format.md; `nimbus info {}` describes the volume)",
+                    name, name));
   nlohmann::json doc;
+  const std::string str = text.str();
   try {
-    doc = nlohmann::json::parse(text.str());
+    doc = nlohmann::json::parse(str);
+  } catch (const nlohmann::json::parse_error& e) {
+    // Where, in lines and columns, rather than nlohmann's byte offset and exception id.
+    const size_t at = std::min(e.byte > 0 ? e.byte - 1 : 0, str.size());
+    const size_t line = 1 + size_t(std::count(str.begin(), str.begin() + long(at), '\n'));
+    const size_t bol = str.rfind('\n', at == 0 ? 0 : at - 1);
+    const size_t column = at - (bol == std::string::npos || at == 0 ? 0 : bol + 1) + 1;
+    throw Error(
+        fmt::format("{}: not valid JSON at line {}, column {} (a scene is a JSON file: "
+                    "docs/scene-format.md)",
+                    name, line, column));
   } catch (const nlohmann::json::exception& e) {
     throw Error(fmt::format("{}: not valid JSON: {}", name, e.what()));
   }

@@ -1,0 +1,23 @@
+// Output paths, checked before any work is done (commands.h).
+#include <fmt/format.h>
+
+#include <filesystem>
+
+#include "commands.h"
+#include "nimbus/error.h"
+
+namespace nimbus::cli {
+
+void check_output_path(const std::string& path, const std::string& option) {
+  namespace fs = std::filesystem;
+  if (path.empty()) throw Error(fmt::format("{}: empty file name", option));
+  const fs::path p(path);
+  std::error_code ec;
+  if (fs::is_directory(p, ec) || !p.has_filename())
+    throw Error(fmt::format("{}: {} is a directory; name the file to write", option, path));
+  const fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
+  if (!fs::is_directory(dir, ec))
+    throw Error(fmt::format("{}: {}: the folder '{}' does not exist", option, path, dir.string()));
+}
+
+}  // namespace nimbus::cli
