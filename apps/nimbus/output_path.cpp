@@ -14,7 +14,7 @@ void check_output_path(const std::string& path, const std::string& option) {
   const fs::path p(path);
   std::error_code ec;
   if (fs::is_directory(p, ec) || !p.has_filename())
-    throw Error(fmt::format("{}: {} is a directory; name the file to write", option, path));
+    throw Error(fmt::format("{}: {} names a folder, not a file", option, path));
   const fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
   if (!fs::is_directory(dir, ec))
     throw Error(fmt::format("{}: {}: the folder '{}' does not exist", option, path, dir.string()));

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <iterator>
 #include <string>
+#include <tuple>
 
 #include "support/scratch_dir.h"
 
@@ -28,6 +29,44 @@ TEST(CliArgs, SlabExtinctionThatOverflowsIsRefused) {
   const auto [code, err] = run("slab --mu-s 1e308 --mu-a 1e308 --g 0.5 --thickness 1 --photons 20");
   EXPECT_EQ(code, 2);
   EXPECT_NE(err.find("--mu-s + --mu-a must be finite"), std::string::npos) << err;
+}
+
+// What a new user met (issue 13): each is now exit 2 with a message that says what is wrong.
+TEST(CliArgs, ParserErrorsCarryThePrefix) {
+  const auto [code, err] = run("render --bogus");
+  EXPECT_EQ(code, 2);
+  EXPECT_EQ(err.rfind("nimbus: error: ", 0), 0u) << err;
+  EXPECT_NE(err.find("--bogus"), std::string::npos) << err;
+}
+
+TEST(CliArgs, OutputFolderIsNotAFormat) {
+  const auto [code, err] = run("render -o /tmp/");
+  EXPECT_EQ(code, 2);
+  EXPECT_NE(err.find("names a folder, not a file"), std::string::npos) << err;
+}
+
+TEST(CliArgs, BeamAndSlabCheckTheirOutputBeforeTheWork) {
+  // 1e9 photons would take minutes: the check comes first.
+  auto [code, err] = run("beam --phase hg:0.9 --albedo 0.9 --depths 1 --photons 1e9 -o /nonexistent/x.csv");
+  EXPECT_EQ(code, 2);
+  EXPECT_NE(err.find("/nonexistent"), std::string::npos) << err;
+  std::tie(code, err) =
+      run("slab --mu-s 1 --mu-a 0.1 --g 0.5 --thickness 1 --photons 1e9 --csv /nonexistent/y.csv");
+  EXPECT_EQ(code, 2);
+  EXPECT_NE(err.find("--csv"), std::string::npos) << err;
+}
+
+TEST(CliArgs, VolumeOrBrokenJsonGivenAsTheScene) {
+  test::ScratchDir dir("cli_args_scene");
+  std::ofstream(dir / "cloud.vdb") << "not read";
+  auto [code, err] = run("render " + (dir / "cloud.vdb").string() + " -o " + (dir / "a.exr").string());
+  EXPECT_EQ(code, 2);
+  EXPECT_NE(err.find("a volume, not a scene"), std::string::npos) << err;
+  std::ofstream(dir / "bad.json") << "{\"camera\": {\n  \"width\": 3,,\n}}";
+  std::tie(code, err) = run("render " + (dir / "bad.json").string() + " -o " + (dir / "a.exr").string());
+  EXPECT_EQ(code, 2);
+  EXPECT_NE(err.find("not valid JSON at line 2, column 14"), std::string::npos) << err;
+  EXPECT_EQ(err.find("json.exception"), std::string::npos) << err;
 }
 
 }  // namespace
