@@ -2,6 +2,7 @@
 #include <fmt/format.h>
 
 #include <csignal>
+#include <cstdio>
 #include <filesystem>
 #include <functional>
 #include <nlohmann/json.hpp>
@@ -39,8 +40,10 @@ struct RenderArgs {
   int deep_samples = 32;
   int threads = 0;
   double exposure = 0.0;
-  double time_limit = 0.0;  // --time: seconds, 0 = none
-  std::string resume;       // --resume: the EXR to continue
+  double time_limit = 0.0;        // --time: seconds, 0 = none
+  std::string resume;             // --resume: the EXR to continue
+  std::vector<std::string> sets;  // --set PATH=VALUE
+  std::string res;                // --res WxH
   bool quiet = false;
 };
 
@@ -87,8 +90,11 @@ Scene resume_scene(const RenderArgs& args, FilmState* state, std::optional<int>*
   if (!args.scene.empty())
     throw Error(
         fmt::format("--resume: {}: the scene comes from the EXR's header; give no scene file", args.scene));
-  if (args.integrator || args.seed || args.layers_given || !args.deep.empty())
-    throw Error("--resume: --integrator, --seed, --layers and --deep must be those of the resumed render");
+  if (args.integrator || args.seed || args.layers_given || !args.deep.empty() || !args.sets.empty() ||
+      !args.res.empty())
+    throw Error(
+        "--resume: --integrator, --seed, --layers, --deep, --set and --res must be those of the resumed "
+        "render");
   ImageMetadata meta;
   read_exr(args.resume, &meta);
   *state = read_exr_state(args.resume);
@@ -118,6 +124,30 @@ void write_outputs(const RenderArgs& args, const RenderResult& r, const std::fil
   if (!args.deep.empty() && !r.deep.offsets.empty()) write_deep_exr(name(args.deep), r.deep, r.metadata);
 }
 
+// --res WxH as two --set overrides.
+std::vector<std::string> scene_overrides(const RenderArgs& args) {
+  std::vector<std::string> sets = args.sets;
+  if (!args.res.empty()) {
+    int w = 0, h = 0;
+    char x = 0, extra = 0;
+    if (std::sscanf(args.res.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || (x != 'x' && x != 'X') ||
+        w < 1 || h < 1)
+      throw Error(fmt::format("--res '{}': expected WIDTHxHEIGHT, e.g. 1920x1080", args.res));
+    sets.push_back(fmt::format("camera.width={}", w));
+    sets.push_back(fmt::format("camera.height={}", h));
+  }
+  return sets;
+}
+
+Scene load_render_scene(const RenderArgs& args) {
+  const std::vector<std::string> sets = scene_overrides(args);
+  if (!args.scene.empty()) return load_scene(args.scene, sets);
+  if (sets.empty()) return builtin_demo_scene();
+  nlohmann::json doc = builtin_demo_document();
+  for (const std::string& o : sets) apply_scene_override(doc, o);
+  return parse_scene(doc, "(built-in demo)", ".");
+}
+
 int run_render(RenderArgs args) {
   if (!args.resume.empty() && args.output.empty()) args.output = args.resume;
   if (args.output.empty()) throw Error("--output is required");
@@ -132,9 +162,7 @@ int run_render(RenderArgs args) {
   } else {
     options.spp = args.spp;
   }
-  const Scene scene = resumed              ? std::move(*resumed)
-                      : args.scene.empty() ? builtin_demo_scene()
-                                           : load_scene(args.scene);
+  const Scene scene = resumed ? std::move(*resumed) : load_render_scene(args);
   options.seed = args.seed;
   options.integrator = args.integrator;
   if (args.layers_given) options.layers = args.layers;
@@ -213,6 +241,12 @@ void add_render_command(CLI::App& app, Action& action) {
       ->needs(deep);
   cmd->add_option("--exposure", args->exposure, "Exposure in stops for PNG output")
       ->check(CLI::Range(-64.0, 64.0));
+  cmd->add_option("--set", args->sets,
+                  "Override a scene field, validated as if in the file: PATH=VALUE with PATH like "
+                  "camera.width or media.0.sigma_s, VALUE JSON (2, [1,0,0], true) or a string; repeatable")
+      ->allow_extra_args(false)
+      ->take_all();
+  cmd->add_option("--res", args->res, "Image size WIDTHxHEIGHT (sets camera.width and camera.height)");
   cmd->add_option("--time", args->time_limit,
                   "Time budget in seconds, set-up included: whole passes (1, 2, 4, ... spp) while they fit")
       ->check(CLI::Range(0.0, 1e8));

@@ -152,8 +152,19 @@ struct Scene {
 };
 
 // Reads, validates and loads (volumes included) a scene file. Every error is a nimbus::Error
-// naming the file and the JSON path: "scene.json: /media/0/sigma_s: must be >= 0".
-Scene load_scene(const std::filesystem::path& file);
+// naming the file and the JSON path: "scene.json: /media/0/sigma_s: must be >= 0". `overrides`
+// (apply_scene_override) change the document before it is validated, as if written in the file.
+Scene load_scene(const std::filesystem::path& file, const std::vector<std::string>& overrides = {});
+// A scene file's JSON document, not yet validated.
+nlohmann::json read_scene_document(const std::filesystem::path& file);
+// Sets one field of a scene document from "PATH=VALUE" (render --set): PATH is object keys and array
+// indices separated by dots ("camera.width", "media.0.sigma_s"; a missing key is added, with objects
+// made on the way), VALUE is read as JSON when it parses as JSON (2, [1, 0, 0], true, "x") and as a
+// string otherwise (cloud.vdb). Throws nimbus::Error naming the override for a malformed assignment, an
+// index past the end of an array, or a path through a number or string.
+void apply_scene_override(nlohmann::json& doc, const std::string& assignment);
+// The built-in demo's document.
+nlohmann::json builtin_demo_document();
 // The same from an in-memory document; `name` stands for the file in messages, relative volume
 // paths resolve against `base_dir`.
 Scene parse_scene(const nlohmann::json& doc, const std::string& name, const std::filesystem::path& base_dir);

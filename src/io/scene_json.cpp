@@ -180,7 +180,7 @@ Scene parse_scene(const nlohmann::json& doc, const std::string& name, const std:
   return scene;
 }
 
-Scene load_scene(const std::filesystem::path& file) {
+nlohmann::json read_scene_document(const std::filesystem::path& file) {
   const std::string name = file.string();
   std::error_code ec;
   if (!std::filesystem::exists(file, ec)) throw Error(fmt::format("{}: no such file", name));
@@ -212,7 +212,13 @@ Scene load_scene(const std::filesystem::path& file) {
   } catch (const nlohmann::json::exception& e) {
     throw Error(fmt::format("{}: not valid JSON: {}", name, e.what()));
   }
-  Scene scene = parse_scene(doc, name, file.parent_path());
+  return doc;
+}
+
+Scene load_scene(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
+  nlohmann::json doc = read_scene_document(file);
+  for (const std::string& o : overrides) apply_scene_override(doc, o);
+  Scene scene = parse_scene(doc, file.string(), file.parent_path());
   scene.file = file;
   return scene;
 }

@@ -39,29 +39,29 @@ void build_cloud_shape(CloudShape& c) {
       DensityGrid::from_nanovdb(std::move(handle), fmt::format("procedural cloud (seed {})", c.seed)));
 }
 
-Scene builtin_demo_scene() {
-  const nlohmann::json doc = {
-      {"camera",
-       {{"position", {0.0, -4.2, 0.35}},
-        {"look_at", {0.0, 0.0, 0.0}},
-        {"up", {0, 0, 1}},
-        {"fov_y_deg", 36},
-        {"width", 320},
-        {"height", 240}}},
-      {"media",
-       {{{"shape",
-          {{"type", "cloud"}, {"center", {0, 0, 0}}, {"radius", 1.2}, {"seed", 7}, {"resolution", 128}}},
-         {"sigma_s", 12.0},
-         {"sigma_a", 0.02},
-         {"phase", {{"type", "hg"}, {"g", 0.85}}}}}},
-      {"lights",
-       {{{"type", "directional"},
-         {"direction", {-0.75, -0.3, -0.55}},
-         {"irradiance", {3.4, 3.2, 2.9}},
-         {"angular_diameter_deg", 0.53}},
-        {{"type", "environment"}, {"radiance", {0.07, 0.12, 0.25}}}}},
-      {"integrator", {{"type", "pathtrace"}, {"spp", 256}, {"seed", 1}}}};
-  return parse_scene(doc, "(built-in demo)", ".");
+Scene builtin_demo_scene() { return parse_scene(builtin_demo_document(), "(built-in demo)", "."); }
+
+nlohmann::json builtin_demo_document() {
+  return {{"camera",
+           {{"position", {0.0, -4.2, 0.35}},
+            {"look_at", {0.0, 0.0, 0.0}},
+            {"up", {0, 0, 1}},
+            {"fov_y_deg", 36},
+            {"width", 320},
+            {"height", 240}}},
+          {"media",
+           {{{"shape",
+              {{"type", "cloud"}, {"center", {0, 0, 0}}, {"radius", 1.2}, {"seed", 7}, {"resolution", 128}}},
+             {"sigma_s", 12.0},
+             {"sigma_a", 0.02},
+             {"phase", {{"type", "hg"}, {"g", 0.85}}}}}},
+          {"lights",
+           {{{"type", "directional"},
+             {"direction", {-0.75, -0.3, -0.55}},
+             {"irradiance", {3.4, 3.2, 2.9}},
+             {"angular_diameter_deg", 0.53}},
+            {{"type", "environment"}, {"radiance", {0.07, 0.12, 0.25}}}}},
+          {"integrator", {{"type", "pathtrace"}, {"spp", 256}, {"seed", 1}}}};
 }
 
 }  // namespace nimbus

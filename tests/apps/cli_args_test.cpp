@@ -4,11 +4,13 @@
 #include <sys/wait.h>
 
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <string>
 #include <tuple>
 
+#include "nimbus/image.h"
 #include "support/scratch_dir.h"
 
 namespace nimbus {
@@ -67,6 +69,26 @@ TEST(CliArgs, VolumeOrBrokenJsonGivenAsTheScene) {
   EXPECT_EQ(code, 2);
   EXPECT_NE(err.find("not valid JSON at line 2, column 14"), std::string::npos) << err;
   EXPECT_EQ(err.find("json.exception"), std::string::npos) << err;
+}
+
+TEST(CliArgs, SetAndResOverrideTheScene) {
+  test::ScratchDir dir("cli_args_set");
+  const std::string out = (dir / "a.exr").string();
+  auto [code, err] = run("render --res 24x12 --set integrator.spp=1 --set integrator.type=single -o " + out);
+  EXPECT_EQ(code, 0) << err;
+  ImageMetadata meta;
+  const Image img = read_exr(out, &meta);
+  EXPECT_EQ(img.width, 24);
+  EXPECT_EQ(img.height, 12);
+  for (const auto& [k, v] : meta)
+    if (k == "nimbus/integrator") EXPECT_EQ(v, "single");
+  std::tie(code, err) = run("render --set media.3.sigma_s=1 -o " + (dir / "b.exr").string());
+  EXPECT_EQ(code, 2);
+  EXPECT_NE(err.find("--set media.3.sigma_s"), std::string::npos) << err;
+  std::tie(code, err) = run("render --res 0x5 -o " + (dir / "b.exr").string());
+  EXPECT_EQ(code, 2);
+  EXPECT_NE(err.find("--res"), std::string::npos) << err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "b.exr"));
 }
 
 }  // namespace
