@@ -172,6 +172,7 @@ int run_render(RenderArgs args) {
   options.cancel = &g_cancel;
   const std::string label = !args.resume.empty() ? args.resume : args.scene.empty() ? "demo" : args.scene;
   ProgressBar bar(fmt::format("nimbus: {}", label), !args.quiet && stderr_is_terminal());
+  options.setup = [&bar](const std::string& what) { bar.stage(what); };
   options.progress = [&bar](int64_t done, int64_t total, int64_t samples) {
     bar.update(done, total, samples);
   };

@@ -29,6 +29,15 @@ void ProgressBar::update(int64_t done, int64_t total, int64_t samples) {
   drawn_ = true;
 }
 
+void ProgressBar::stage(const std::string& text) {
+  if (!enabled_) return;
+  std::lock_guard<std::mutex> lock(mutex_);
+  const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  fmt::print(stderr, "\r{} {} ({:.1f}s)          ", label_, text, elapsed);
+  std::fflush(stderr);
+  drawn_ = true;
+}
+
 void ProgressBar::finish() {
   std::lock_guard<std::mutex> lock(mutex_);
   if (drawn_) fmt::print(stderr, "\n");

@@ -13,6 +13,8 @@ class ProgressBar {
   explicit ProgressBar(std::string label, bool enabled);
   // Thread-safe; redraws at most ~10 times a second.
   void update(int64_t done, int64_t total, int64_t samples);
+  // A line for a phase without a fraction (the integrator's set-up): the label, the text, the time.
+  void stage(const std::string& text);
   // Ends the line (if anything was drawn).
   void finish();
 

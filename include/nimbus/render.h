@@ -27,6 +27,8 @@ struct RenderOptions {
   // Called from worker threads as tiles finish: (pixel samples done, pixel samples to take, the same
   // count of samples), counted over all passes of this render.
   std::function<void(int64_t done, int64_t total, int64_t samples)> progress;
+  // Called once before the integrator's set-up (shadow maps, photon grids), with what it makes.
+  std::function<void(const std::string& what)> setup;
   // Set to true (e.g. from a signal handler) to stop: the pass under way is dropped and the image is
   // the one of the last whole pass (RenderResult::partial).
   const std::atomic<bool>* cancel = nullptr;

@@ -221,6 +221,9 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
   tbb::task_arena arena(threads);
   std::optional<SceneContext> context;
   std::unique_ptr<Integrator> integrator;
+  if (options.setup)
+    options.setup(fmt::format("setting up {} (scene{})", settings.type,
+                              settings.type == "pathtrace" ? "" : ", shadow maps, photon grids"));
   arena.execute([&] {
     context.emplace(scene);
     integrator = make_integrator(*context, settings, scene.file.empty() ? "scene" : scene.file.string());
