@@ -1,6 +1,7 @@
 #include "integrators/pathtrace.h"
 
 #include "core/json_reader.h"
+#include "integrators/area_light_view.h"
 #include "integrators/camera_layers.h"
 #include "integrators/surface_light.h"
 #include "integrators/tracking.h"
@@ -213,6 +214,12 @@ Rgb PathTracer::Li(const Ray& ray, Rng& rng, CameraSample* sample) const {
       if (rng.uniform() >= q) break;
       beta /= q;
     }
+  }
+  // The visible area lights the camera ray meets, through the media in front (lights are met by NEE only).
+  if (has_visible_area_lights(ctx_)) {
+    const Rgb Le = visible_area_lights(ctx_, ray, rng);
+    L += Le;
+    first.direct += Le;
   }
   if (sample) fill_camera_sample(ctx_, first, L, sample);
   return L;
