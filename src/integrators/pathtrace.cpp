@@ -215,12 +215,8 @@ Rgb PathTracer::Li(const Ray& ray, Rng& rng, CameraSample* sample) const {
       beta /= q;
     }
   }
-  // The visible area lights the camera ray meets, through the media in front (lights are met by NEE only).
-  if (has_visible_area_lights(ctx_)) {
-    const Rgb Le = visible_area_lights(ctx_, ray, rng);
-    L += Le;
-    first.direct += Le;
-  }
+  const Rgb Le = visible_area_lights(ctx_, ray, rng);  // what the camera sees of lights (else NEE only)
+  L += Le, first.direct += Le;
   if (sample) fill_camera_sample(ctx_, first, L, sample);
   return L;
 }
