@@ -48,6 +48,7 @@ TEST(AreaLightsInIntegrators, SpotSingleScatterMatchesTheQuadrature) {
   const SceneContext ctx(scene);
   const PathTracer pt(ctx, 1);
   const SingleScatter single(ctx, SingleSettings{0.02, 1});
+  const SingleScatter single_map(ctx, SingleSettings{0.02, 1, Transmittance::shadow_map, 64});
   for (double z0 : {0.0, 0.4}) {
     const int m = 20000;
     double exact = 0.0;
@@ -65,7 +66,49 @@ TEST(AreaLightsInIntegrators, SpotSingleScatterMatchesTheQuadrature) {
     EXPECT_NEAR(a.mean, exact, 5.0 * a.stderr_mean() + 0.003 * exact) << "single, z0 " << z0;
     EXPECT_NEAR(b.mean, exact, 5.0 * b.stderr_mean()) << "pathtrace, z0 " << z0;
     EXPECT_LT(b.stderr_mean(), 0.03 * exact);  // the test has power
+    // With a shadow map, the spot reads the point light's map (its nodes march to the spot's position).
+    const test::MeanAccumulator c = mean_li(single_map, ray, 2000);
+    EXPECT_NEAR(c.mean, exact, 5.0 * c.stderr_mean() + 0.01 * exact) << "single (shadow map), z0 " << z0;
   }
+}
+
+// A sphere light (radius 0.5 at height 2.5) above the same box: single scattering along a ray at height
+// z0 is the integral over the ray and over the light's cap of directions of sigma_s / (4 pi) T_cam L
+// T_light, every leg to the light leaving the box through its top (checked).
+TEST(AreaLightsInIntegrators, SphereLightSingleScatterMatchesTheQuadrature) {
+  const double sigma_s = 0.3, sigma_t = 0.4, L = 6.0, r = 0.5;
+  const Vec3 c(0, 0, 2.5);
+  const Scene scene = test::scene_from_json("{" + test::camera_json() + R"(,
+    "media": [{"shape": {"type": "box", "min": [-1, -1, -1], "max": [1, 1, 1]}, "sigma_s": 0.3, "sigma_a": 0.1}],
+    "lights": [{"type": "sphere", "center": [0, 0, 2.5], "radius": 0.5, "radiance": 6}]})");
+  const SceneContext ctx(scene);
+  const PathTracer pt(ctx, 1);
+  const SingleScatter single(ctx, SingleSettings{0.02, 1});
+  const double z0 = 0.2;
+  const int mt = 100, mc = 60;
+  double exact = 0.0;
+  for (int k = 0; k < mt; ++k) {
+    const double s = 2.0 * (k + 0.5) / mt;
+    const Vec3 x(-1.0 + s, 0.0, z0);
+    const double d = length(c - x), cos_max = std::sqrt(1.0 - r * r / (d * d));
+    double cap = 0.0;
+    for (int i = 0; i < mc; ++i)
+      for (int j = 0; j < mc; ++j) {
+        const double ct = cos_max + (1.0 - cos_max) * (i + 0.5) / mc;
+        const Vec3 w = spherical_direction(ct, 2.0 * kPi * (j + 0.5) / mc, (c - x) / d);
+        const double len = (1.0 - z0) / w.z;
+        const Vec3 exit = x + w * len;
+        ASSERT_TRUE(std::abs(exit.x) <= 1.0 && std::abs(exit.y) <= 1.0);
+        cap += L * std::exp(-sigma_t * len);
+      }
+    exact += sigma_s / (4.0 * kPi) * std::exp(-sigma_t * s) * cap * (1.0 - cos_max) * 2.0 * kPi / (mc * mc);
+  }
+  exact *= 2.0 / mt;
+  const Ray ray{Vec3(-3, 0, z0), Vec3(1, 0, 0)};
+  const test::MeanAccumulator a = mean_li(single, ray, 4000), b = mean_li(pt, ray, 40000);
+  EXPECT_NEAR(a.mean, exact, 5.0 * a.stderr_mean() + 0.003 * exact) << "single";
+  EXPECT_NEAR(b.mean, exact, 5.0 * b.stderr_mean()) << "pathtrace";
+  EXPECT_LT(b.stderr_mean(), 0.03 * exact);
 }
 
 // A diffuse floor (z = 0, albedo 0.5) under an absorbing slab (0.5 < z < 1, sigma_a 1) and a light
@@ -88,6 +131,11 @@ void expect_floor_matches(const Scene& scene, double exact) {
   EXPECT_NEAR(a.mean, exact, 5.0 * a.stderr_mean()) << "pathtrace";
   EXPECT_NEAR(b.mean, exact, 5.0 * b.stderr_mean()) << "single";
   EXPECT_LT(a.stderr_mean(), 0.02 * exact);
+  // With shadow maps, an area light's shadow is marched to a sampled point of it (no map): the same
+  // answer up to the march's step error.
+  const SingleScatter single_map(ctx, SingleSettings{0.1, 1, Transmittance::shadow_map, 64});
+  const test::MeanAccumulator c = mean_li(single_map, ray, 20000, 3);
+  EXPECT_NEAR(c.mean, exact, 5.0 * c.stderr_mean() + 0.005 * exact) << "single (shadow map)";
 }
 
 TEST(AreaLightsInIntegrators, SphereLightThroughAnAbsorberMatchesTheQuadrature) {
