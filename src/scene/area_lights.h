@@ -5,7 +5,8 @@
 // A sphere light emits radiance L outward from every point of its surface (power 4 pi^2 r^2 L); it is
 // sampled by the solid angle of the cap seen from the shading point (uniform in the cone, pdf
 // 1 / (2 pi (1 - cos_max))), exact for any distance. A rectangle light emits L from one side, along its
-// normal (power pi A L); it is sampled uniformly by area (pdf d^2 / (A cos_l) in solid angle). Neither
+// normal (power pi A L); it is sampled uniformly in the solid angle it subtends (Urena et al. 2013; by
+// area, pdf d^2 / (A cos_l), where that solid angle is below 1e-3 sr). Neither
 // occludes anything: they are not in the surfaces' scene.
 #pragma once
 

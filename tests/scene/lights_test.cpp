@@ -125,23 +125,47 @@ TEST(RectangleLight, IrradianceMatchesAMidpointQuadrature) {
   r.height = 0.7;
   r.radiance = Rgb(2.5);
   const Vec3 ew = normalize(cross(r.normal, r.up));
-  for (const Vec3& n : {Vec3(0, 0, 1), normalize(Vec3(0.5, 0.2, 1.0)), normalize(Vec3(-0.3, 0.0, 1.0))}) {
-    const Vec3 p(0.0);
-    // E = int L cos_p cos_l / d^2 dA, 600 x 600 midpoints.
-    const int m = 600;
-    double exact = 0.0;
-    for (int i = 0; i < m; ++i)
-      for (int j = 0; j < m; ++j) {
-        const Vec3 q =
-            r.center + ew * (((i + 0.5) / m - 0.5) * r.width) + r.up * (((j + 0.5) / m - 0.5) * r.height);
-        const Vec3 v = q - p;
-        const double d2 = v.length2(), dd = std::sqrt(d2);
-        exact += 2.5 * std::max(0.0, dot(n, v) / dd) * std::max(0.0, -dot(r.normal, v) / dd) / d2;
-      }
-    exact *= r.width * r.height / (double(m) * m);
-    const test::MeanAccumulator e = irradiance(r, p, n, 40000);
-    EXPECT_NEAR(e.mean, exact, 5.0 * e.stderr_mean()) << n.x;
-    EXPECT_LT(e.stderr_mean(), 0.01 * exact);
+  // Points far (by area: under 1e-3 sr), at a middle distance and close (by solid angle), several normals.
+  for (const Vec3& p : {Vec3(0.0), Vec3(0.5, 0.0, 1.3), Vec3(3.0, -1.0, -30.0)}) {
+    for (const Vec3& n : {Vec3(0, 0, 1), normalize(Vec3(0.5, 0.2, 1.0)), normalize(Vec3(-0.3, 0.0, 1.0))}) {
+      // E = int L cos_p cos_l / d^2 dA, 600 x 600 midpoints.
+      const int m = 600;
+      double exact = 0.0;
+      for (int i = 0; i < m; ++i)
+        for (int j = 0; j < m; ++j) {
+          const Vec3 q =
+              r.center + ew * (((i + 0.5) / m - 0.5) * r.width) + r.up * (((j + 0.5) / m - 0.5) * r.height);
+          const Vec3 v = q - p;
+          const double d2 = v.length2(), dd = std::sqrt(d2);
+          exact += 2.5 * std::max(0.0, dot(n, v) / dd) * std::max(0.0, -dot(r.normal, v) / dd) / d2;
+        }
+      exact *= r.width * r.height / (double(m) * m);
+      const test::MeanAccumulator e = irradiance(r, p, n, 40000);
+      EXPECT_NEAR(e.mean, exact, 5.0 * e.stderr_mean() + 1e-4 * exact) << p.z << " " << n.x;
+      EXPECT_LT(e.stderr_mean(), 0.01 * exact);
+    }
+  }
+  // By solid angle every sample lies on the rectangle and weighs L times the solid angle (here the
+  // quadrature of cos_l / d^2 dA), the same for every sample.
+  const Vec3 p(0.5, 0.0, 1.3);
+  double solid_angle = 0.0;
+  const int m = 600;
+  for (int i = 0; i < m; ++i)
+    for (int j = 0; j < m; ++j) {
+      const Vec3 v =
+          r.center + ew * (((i + 0.5) / m - 0.5) * r.width) + r.up * (((j + 0.5) / m - 0.5) * r.height) - p;
+      solid_angle += -dot(r.normal, v) / std::pow(v.length2(), 1.5);
+    }
+  solid_angle *= r.width * r.height / (double(m) * m);
+  Rng rng(2, 2);
+  for (int i = 0; i < 1000; ++i) {
+    LightSample ls;
+    ASSERT_TRUE(sample_light(Light(r), p, rng.uniform(), rng.uniform(), &ls));
+    const Vec3 q = p + ls.wi * ls.distance - r.center;
+    EXPECT_NEAR(dot(q, r.normal), 0.0, 1e-9);
+    EXPECT_LE(std::abs(dot(q, ew)), 0.6 + 1e-9);
+    EXPECT_LE(std::abs(dot(q, r.up)), 0.35 + 1e-9);
+    EXPECT_NEAR(ls.weight.x, 2.5 * solid_angle, 1e-4 * 2.5 * solid_angle);
   }
   // One-sided: nothing reaches a point behind it.
   LightSample ls;
