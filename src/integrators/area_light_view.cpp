@@ -4,6 +4,7 @@
 #include <limits>
 
 #include "integrators/surface_light.h"
+#include "integrators/tracking.h"
 #include "scene/area_lights.h"
 
 namespace nimbus {
@@ -33,6 +34,24 @@ Rgb visible_area_lights(const SceneContext& ctx, const Ray& ray, Rng& rng, doubl
     L += Le * shadow_transmittance(ctx, ray.o, ray.d, t, rng, march_step);
   }
   return L;
+}
+
+void marched_full_and_reduced(const SceneContext& ctx, const Vec3& p, const Vec3& w, double tmax,
+                              double tau_step, const std::vector<double>& peak_fraction, Rgb* T_full,
+                              Rgb* T_reduced) {
+  Rgb tau(0.0), tau_reduced(0.0);
+  MediumPoint mp;
+  march(ctx.majorants, p, w, tmax, tau_step, 0.5, [&](const Vec3& x, double, double dt) {
+    ctx.media.eval(x, &mp);
+    Rgb reduced = mp.sigma_t();
+    tau += reduced * dt;
+    for (int i = 0; i < mp.count && i < int(peak_fraction.size()); ++i)
+      reduced -= mp.sigma_s_i[i] * peak_fraction[i];
+    tau_reduced += reduced * dt;
+    return min_component(tau_reduced) < 50.0;
+  });
+  *T_full = exp(-tau);
+  *T_reduced = exp(-tau_reduced);
 }
 
 }  // namespace nimbus

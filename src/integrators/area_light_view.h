@@ -19,4 +19,12 @@ Rgb visible_area_lights(const SceneContext& ctx, const Ray& ray, Rng& rng, doubl
 // True when some light of ctx is a visible area light (integrators skip the call otherwise).
 bool has_visible_area_lights(const SceneContext& ctx);
 
+// One midpoint march from p along w over (0, tmax) in steps of tau_step optical depth against the
+// majorant (as marched_transmittance) giving both the transmittance of the full extinction and of the
+// extinction less each medium's peak_fraction of its scattering (reduced_sigma_t): `mfs`'s two
+// transmittances to a sampled point of an area light, for the price of one march.
+void marched_full_and_reduced(const SceneContext& ctx, const Vec3& p, const Vec3& w, double tmax,
+                              double tau_step, const std::vector<double>& peak_fraction, Rgb* T_full,
+                              Rgb* T_reduced);
+
 }  // namespace nimbus

@@ -230,15 +230,14 @@ MfsIntegrator::MediumRadiance MfsIntegrator::medium_radiance(int i, const Vec3& 
 }
 
 LightBeam MfsIntegrator::light_beam(size_t l, int i, const Vec3& p, const LightSample& ls) const {
-  const bool area = is_area_light(ctx_.lights[l]);  // an area light: march to its sampled point instead
-  const Rgb T_light =
-      area ? marched_transmittance(ctx_.media, ctx_.majorants, p, ls.wi, ls.distance, kSurfaceShadowStep)
-           : full_maps_[l].lookup(p);
-  Rgb T_wide = T_light;
-  if (s_.forward_light_path())
-    T_wide = area ? marched_transmittance(ctx_.media, ctx_.majorants, p, ls.wi, ls.distance,
-                                          kSurfaceShadowStep, f_)
-                  : reduced_maps_[l].lookup(p);
+  Rgb T_light, T_wide;
+  if (is_area_light(ctx_.lights[l])) {  // an area light: march to its sampled point instead of a map
+    marched_full_and_reduced(ctx_, p, ls.wi, ls.distance, kSurfaceShadowStep, f_, &T_light, &T_wide);
+    if (!s_.forward_light_path()) T_wide = T_light;
+  } else {
+    T_light = full_maps_[l].lookup(p);
+    T_wide = s_.forward_light_path() ? reduced_maps_[l].lookup(p) : T_light;
+  }
   Rgb R(1.0), mean_cos(1.0);
   const bool traced = beam_ && beam_->lookup(l, p, &R, &mean_cos);
   return peak_only_beam(T_light, T_wide, traced, R, mean_cos, splits_[i]->peak_moments(), theta2_[i],

@@ -56,6 +56,9 @@ def parse_args():
                    help="UV sphere segments around (rings = segments / 2)")
     p.add_argument("--npy", default=None, help="also save the pixels as (h, w, 3) float32 .npy")
     p.add_argument("--blend", default=None, help="also save the built .blend (debugging)")
+    p.add_argument("--sphere-lights", choices=["lamp", "mesh"], default="lamp",
+                   help="sphere lights as POINT lamps of radius r (Cycles samples a disc: dimmer nearby) or "
+                        "as emissive, transparent UV spheres (exact up to tessellation)")
     p.add_argument("--allow-multi-lobe", action="store_true",
                    help="render double_hg as two Volume Scatter closures although Cycles 3.4 gets it wrong")
     return p.parse_args(argv)
@@ -337,7 +340,7 @@ def build_media(media, segments):
 
 
 # --- Lights -----------------------------------------------------------------------------------
-def build_lights(lights):
+def build_lights(lights, sphere_lights="lamp", segments=256):
     scene = bpy.context.scene
     world = bpy.data.worlds.new("world")
     world.use_nodes = True
@@ -364,6 +367,8 @@ def build_lights(lights):
             data.shadow_soft_size = 0.0
             obj = link(bpy.data.objects.new(f"point{i}", data))
             obj.location = Vector(light["position"])
+        elif kind == "sphere" and sphere_lights == "mesh":
+            build_sphere_light_mesh(i, light, segments)
         elif kind in ("spot", "sphere", "rectangle"):
             build_area_or_spot_light(i, light)
         elif kind == "environment":
@@ -395,6 +400,43 @@ def spot_without_cosine(data, axis):
     nt.links.new(dot.outputs["Value"], clamp.inputs[0])
     nt.links.new(clamp.outputs["Value"], inverse.inputs[1])
     nt.links.new(inverse.outputs["Value"], emission.inputs["Strength"])
+
+
+def build_sphere_light_mesh(i, light, segments):
+    """A sphere light as a UV sphere (equal volume) whose front faces emit `radiance` (Emission strength 1
+    = radiance 1) and which every ray passes through (Transparent BSDF), like nimbus' sphere light: it
+    emits outward only and occludes nothing. Seen by the camera only if `visible`."""
+    T = transform_matrix(light.get("transform"))
+    r = light["radius"] * T.to_3x3().col[0].length
+    L = rgb(light["radiance"]) if "radiance" in light else \
+        tuple(p / (4.0 * math.pi ** 2 * r * r) for p in rgb(light["power"]))
+    mesh, _ = sphere_mesh(f"sphere_light{i}", r, segments)
+    obj = link(bpy.data.objects.new(f"sphere_light{i}", mesh))
+    obj.location = T @ Vector(light["center"])
+    for poly in mesh.polygons:
+        poly.use_smooth = True
+    mat = bpy.data.materials.new(f"sphere_light{i}")
+    mat.use_nodes = True
+    nt = mat.node_tree
+    nt.nodes.clear()
+    out = nt.nodes.new("ShaderNodeOutputMaterial")
+    emission = nt.nodes.new("ShaderNodeEmission")
+    emission.inputs["Color"].default_value = (*L, 1.0)
+    emission.inputs["Strength"].default_value = 1.0
+    through = nt.nodes.new("ShaderNodeBsdfTransparent")
+    through2 = nt.nodes.new("ShaderNodeBsdfTransparent")
+    add = nt.nodes.new("ShaderNodeAddShader")
+    mix = nt.nodes.new("ShaderNodeMixShader")
+    geometry = nt.nodes.new("ShaderNodeNewGeometry")
+    nt.links.new(emission.outputs[0], add.inputs[0])
+    nt.links.new(through.outputs[0], add.inputs[1])
+    nt.links.new(geometry.outputs["Backfacing"], mix.inputs["Fac"])
+    nt.links.new(add.outputs[0], mix.inputs[1])  # front faces: emission + transparent
+    nt.links.new(through2.outputs[0], mix.inputs[2])  # back faces: transparent
+    nt.links.new(mix.outputs[0], out.inputs["Surface"])
+    mesh.materials.append(mat)
+    obj.visible_camera = bool(light.get("visible", False))
+    obj.visible_shadow = True
 
 
 def build_area_or_spot_light(i, light):
@@ -525,7 +567,7 @@ def main():
     mesh_info = build_media(scene_json.get("media", []), args.sphere_segments)
     mesh_info += build_surfaces(scene_json.get("surfaces", []), args.sphere_segments,
                                 Path(args.scene).resolve().parent)
-    build_lights(scene_json.get("lights", []))
+    build_lights(scene_json.get("lights", []), args.sphere_lights, args.sphere_segments)
     configure(args, scene_json.get("integrator", {}))
     print("scene_to_blender:", json.dumps({"camera": cam_info, "media": mesh_info,
                                            "samples": bpy.context.scene.cycles.samples,
