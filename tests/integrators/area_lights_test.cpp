@@ -10,6 +10,7 @@
 #include "integrators/mfs.h"
 #include "integrators/octave.h"
 #include "integrators/pathtrace.h"
+#include "integrators/photon_tracer.h"
 #include "integrators/single.h"
 #include "support/scenes.h"
 #include "support/stats.h"
@@ -206,6 +207,50 @@ TEST(AreaLightsInIntegrators, EveryIntegratorSeesAVisibleLightThroughTheMedium) 
   const Ray down{Vec3(3, 0, 8), Vec3(0, 0, -1)}, up{Vec3(3, 0, 3), Vec3(0, 0, 1)};
   EXPECT_NEAR(mean_li(single, down, 10).mean, 7.0, 1e-12);
   EXPECT_EQ(mean_li(single, up, 10).mean, 0.0);
+}
+
+// `mfs`'s photons from a spot aimed at the media's bounding sphere (off the spot's axis, so the aiming
+// cone covers the blended edge and the outside): their summed power is I times the integral of the
+// falloff over the aiming cone (a quadrature). Sphere and rectangle lights' photons leave their surface.
+TEST(AreaLightsInIntegrators, PhotonsFromASpotCarryTheConesPower) {
+  const Scene scene = test::scene_from_json("{" + test::camera_json() + R"(,
+    "media": [{"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1}, "sigma_s": 1}],
+    "lights": [{"type": "spot", "position": [-2.1131, 0, -4.5315], "direction": [0, 0, 1], "intensity": 3,
+                "cone_angle_deg": 60, "blend": 0.5},
+               {"type": "sphere", "center": [0, 0, 3], "radius": 0.5, "radiance": 2},
+               {"type": "rectangle", "center": [0, 0, -3], "normal": [0, 0, 1], "up": [0, 1, 0],
+                "size": [1, 2], "radiance": 2}]})");
+  const SceneContext ctx(scene);
+  const Vec3 spot(-2.1131, 0, -4.5315), c(0.0);
+  const double d = length(c - spot), cos_max = std::sqrt(1.0 - 1.0 / (d * d));
+  const int m = 1000;
+  double exact = 0.0;
+  for (int i = 0; i < m; ++i)
+    for (int j = 0; j < m; ++j) {
+      const double ct = cos_max + (1.0 - cos_max) * (i + 0.5) / m;
+      const Vec3 w = spherical_direction(ct, 2.0 * kPi * (j + 0.5) / m, (c - spot) / d);
+      exact += 3.0 * smoothstep_edge(60.0, 0.5, w.z);
+    }
+  exact *= (1.0 - cos_max) * 2.0 * kPi / (double(m) * m);
+  test::MeanAccumulator acc;
+  const int n = 20000;
+  for (int j = 0; j < n; ++j) {
+    Rng rng(9, j);
+    const Photon ph = emit(ctx, 0, c, 1.0, n, rng);
+    acc.add(ph.power.x * n);
+    EXPECT_EQ(ph.x, spot);
+    Rng r1(10, j), r2(11, j);
+    const Photon s = emit(ctx, 1, c, 1.0, n, r1), q = emit(ctx, 2, c, 1.0, n, r2);
+    EXPECT_NEAR(length(s.x - Vec3(0, 0, 3)), 0.5, 1e-9);
+    EXPECT_GT(dot(s.w, s.x - Vec3(0, 0, 3)), 0.0);
+    EXPECT_NEAR(s.power.x * n, 2.0 * 4.0 * kPi * kPi * 0.25, 1e-9);
+    EXPECT_NEAR(q.x.z, -3.0, 1e-12);
+    EXPECT_GT(q.w.z, 0.0);
+    EXPECT_NEAR(q.power.x * n, 2.0 * kPi * 2.0, 1e-9);
+  }
+  EXPECT_NEAR(acc.mean, exact, 5.0 * acc.stderr_mean());
+  EXPECT_LT(acc.stderr_mean(), 0.01 * exact);
+  EXPECT_LT(exact, 3.0 * 2.0 * kPi * (1.0 - cos_max) * 0.9);  // the edge cuts into the aiming cone
 }
 
 }  // namespace
