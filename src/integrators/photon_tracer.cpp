@@ -34,8 +34,15 @@ Photon emit(const SceneContext& ctx, size_t source, const Vec3& c, double r, dou
       p.x = pt ? pt->position : spot->position;
       const Vec3 v = c - p.x;
       const double dist = v.length();
-      if (dist > r) {
-        const double cos_max = std::sqrt(std::max(0.0, 1.0 - r * r / (dist * dist)));
+      // The narrower of the cone towards the media's sphere and a spot's own cone (both hold every
+      // direction that carries power into the media).
+      const double cos_aim = dist > r ? std::sqrt(std::max(0.0, 1.0 - r * r / (dist * dist))) : -1.0;
+      const double cos_spot = spot ? std::cos(0.5 * spot->cone_angle_deg * kPi / 180.0) : -1.0;
+      if (cos_spot > cos_aim) {
+        p.w = spherical_direction(1.0 - u1 * (1.0 - cos_spot), 2.0 * kPi * u2, spot->direction);
+        p.power = Rgb(2.0 * kPi * (1.0 - cos_spot) / n);
+      } else if (dist > r) {
+        const double cos_max = cos_aim;
         p.w = spherical_direction(1.0 - u1 * (1.0 - cos_max), 2.0 * kPi * u2, v / dist);
         p.power = Rgb(2.0 * kPi * (1.0 - cos_max) / n);
       } else {

@@ -251,6 +251,29 @@ TEST(AreaLightsInIntegrators, PhotonsFromASpotCarryTheConesPower) {
   EXPECT_NEAR(acc.mean, exact, 5.0 * acc.stderr_mean());
   EXPECT_LT(acc.stderr_mean(), 0.01 * exact);
   EXPECT_LT(exact, 3.0 * 2.0 * kPi * (1.0 - cos_max) * 0.9);  // the edge cuts into the aiming cone
+
+  // A spot narrower than the aiming cone sends its photons within its own cone: all of its power,
+  // I times the integral of the falloff over the cone (a quadrature).
+  const Scene narrow = test::scene_from_json("{" + test::camera_json() + R"(,
+    "media": [{"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1}, "sigma_s": 1}],
+    "lights": [{"type": "spot", "position": [0, 0, -3], "direction": [0.1, 0, 1], "intensity": 3,
+                "cone_angle_deg": 20, "blend": 0.5}]})");
+  const SceneContext ctx2(narrow);
+  const Vec3 axis = normalize(Vec3(0.1, 0, 1));
+  double all = 0.0;
+  for (int i = 0; i < m; ++i) {
+    const double ct = std::cos(10.0 * kPi / 180.0) + (1.0 - std::cos(10.0 * kPi / 180.0)) * (i + 0.5) / m;
+    all += 3.0 * smoothstep_edge(20.0, 0.5, ct) * 2.0 * kPi * (1.0 - std::cos(10.0 * kPi / 180.0)) / m;
+  }
+  test::MeanAccumulator acc2;
+  for (int j = 0; j < n; ++j) {
+    Rng rng(12, j);
+    const Photon ph = emit(ctx2, 0, c, 1.0, n, rng);
+    acc2.add(ph.power.x * n);
+    EXPECT_GT(dot(ph.w, axis), std::cos(10.0 * kPi / 180.0) - 1e-12);
+  }
+  EXPECT_NEAR(acc2.mean, all, 5.0 * acc2.stderr_mean());
+  EXPECT_LT(acc2.stderr_mean(), 0.01 * all);
 }
 
 }  // namespace
