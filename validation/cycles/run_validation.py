@@ -181,7 +181,7 @@ def main():
     p.add_argument("--threads", type=int, default=2, help="Cycles threads")
     p.add_argument("--nimbus", default=str(ROOT / "build" / "bin" / "nimbus"))
     p.add_argument("--blender", default="blender")
-    p.add_argument("--sphere-lights", choices=["lamp", "mesh"], default="lamp",
+    p.add_argument("--sphere-lights", choices=["lamp", "mesh"], default="mesh",
                    help="how scene_to_blender.py builds sphere lights (see its --sphere-lights)")
     p.add_argument("--work", default=str(ROOT / "build" / "validation-cycles"))
     p.add_argument("--docs", default=str(ROOT / "docs" / "validation"))

@@ -28,7 +28,8 @@ Mapping (docs/validation/cycles.md explains and checks each line):
   directional  SUN lamp, Strength = irradiance (W/m^2), Color = irradiance / max, angle = angular
                diameter (use 0: Cycles' disc radiance is S/(pi tan^2(a/2)), nimbus' S/(pi sin^2(a/2))).
   point        POINT lamp, radius 0, Power P = 4 pi I (Cycles: I = P / (4 pi) W/sr, eval_fac = 1/(4 pi)).
-  spot, sphere, rectangle: see build_area_or_spot_light.
+  spot, sphere, rectangle: see build_area_or_spot_light (sphere: build_sphere_light_mesh by default,
+               --sphere-lights lamp for a POINT lamp of radius r).
   environment  World Background, Color = radiance, Strength 1 (black world without one).
   integrator   max_events 0 -> volume bounces 1024; max_events k -> volume bounces k - 1.
 """
@@ -56,9 +57,9 @@ def parse_args():
                    help="UV sphere segments around (rings = segments / 2)")
     p.add_argument("--npy", default=None, help="also save the pixels as (h, w, 3) float32 .npy")
     p.add_argument("--blend", default=None, help="also save the built .blend (debugging)")
-    p.add_argument("--sphere-lights", choices=["lamp", "mesh"], default="lamp",
-                   help="sphere lights as POINT lamps of radius r (Cycles samples a disc: dimmer nearby) or "
-                        "as emissive, transparent UV spheres (exact up to tessellation)")
+    p.add_argument("--sphere-lights", choices=["lamp", "mesh"], default="mesh",
+                   help="sphere lights as emissive, transparent UV spheres (default: exact up to tessellation) "
+                        "or as POINT lamps of radius r (Cycles 3.4 samples a disc: dimmer nearby)")
     p.add_argument("--allow-multi-lobe", action="store_true",
                    help="render double_hg as two Volume Scatter closures although Cycles 3.4 gets it wrong")
     return p.parse_args(argv)
@@ -340,7 +341,7 @@ def build_media(media, segments):
 
 
 # --- Lights -----------------------------------------------------------------------------------
-def build_lights(lights, sphere_lights="lamp", segments=256):
+def build_lights(lights, sphere_lights="mesh", segments=256):
     scene = bpy.context.scene
     world = bpy.data.worlds.new("world")
     world.use_nodes = True
