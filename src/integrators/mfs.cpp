@@ -142,7 +142,9 @@ size_t MfsIntegrator::memory_bytes() const {
 Rgb MfsIntegrator::Li(const Ray& ray, Rng& rng, CameraSample* sample) const {
   const Rgb L = trace(ray, rng, sample, 1);
   if (!has_visible_area_lights(ctx_)) return L;
-  return L + visible_area_lights(ctx_, ray, rng, kSurfaceShadowStep);
+  const Rgb Le = visible_area_lights(ctx_, ray, rng, kSurfaceShadowStep);
+  if (sample) sample->direct += Le;  // light straight from a light
+  return L + Le;
 }
 
 Rgb MfsIntegrator::trace(const Ray& ray, Rng& rng, CameraSample* sample, int bounces) const {

@@ -97,7 +97,9 @@ Rgb OctaveIntegrator::octave_scatter(int j, double bj, const Vec3& p, const Vec3
 Rgb OctaveIntegrator::Li(const Ray& ray, Rng& rng, CameraSample* sample) const {
   const Rgb L = trace(ray, rng, sample, 1);
   if (!has_visible_area_lights(ctx_)) return L;
-  return L + visible_area_lights(ctx_, ray, rng, kSurfaceShadowStep);
+  const Rgb Le = visible_area_lights(ctx_, ray, rng, kSurfaceShadowStep);
+  if (sample) sample->direct += Le;  // light straight from a light
+  return L + Le;
 }
 
 Rgb OctaveIntegrator::trace(const Ray& ray, Rng& rng, CameraSample* sample, int bounces) const {

@@ -52,7 +52,9 @@ Rgb SingleScatter::light_transmittance(size_t l, const Vec3& p, const LightSampl
 Rgb SingleScatter::Li(const Ray& ray, Rng& rng, CameraSample* sample) const {
   const Rgb L = trace(ray, rng, sample, 1);
   if (!has_visible_area_lights(ctx_)) return L;
-  return L + visible_area_lights(ctx_, ray, rng, shadow_maps_.empty() ? 0.0 : kSurfaceShadowStep);
+  const Rgb Le = visible_area_lights(ctx_, ray, rng, shadow_maps_.empty() ? 0.0 : kSurfaceShadowStep);
+  if (sample) sample->direct += Le;  // light straight from a light
+  return L + Le;
 }
 
 Rgb SingleScatter::trace(const Ray& ray, Rng& rng, CameraSample* sample, int bounces) const {
