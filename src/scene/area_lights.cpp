@@ -73,6 +73,7 @@ bool sample_spherical_rectangle(const RectangleFrame& f, const Vec3& o, double u
   const double h0 = y0 / std::sqrt(dd * dd + y0 * y0), h1 = y1 / std::sqrt(dd * dd + y1 * y1);
   const double hv = h0 + u2 * (h1 - h0), hv2 = hv * hv;
   const double yv = hv2 < 1.0 - 1e-12 ? std::clamp(hv * dd / std::sqrt(1.0 - hv2), y0, y1) : y1;
+  if (!(std::isfinite(xu) && std::isfinite(yv))) return false;  // degenerate: sample by area instead
   *q = o + f.ex * xu + f.ey * yv + z * z0;
   *solid_angle = S;
   return true;

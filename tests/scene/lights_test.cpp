@@ -177,6 +177,32 @@ TEST(RectangleLight, IrradianceMatchesAMidpointQuadrature) {
   EXPECT_FALSE(hit_area_light(Light(r), Vec3(2.0, 0.1, 0.0), Vec3(0, 0, 1), 1e30, &t, &L));   // beside it
 }
 
+TEST(RectangleLight, SamplesStayFiniteNextToTheLight) {
+  // Just in front of the plane, inside and outside the rectangle's outline: finite weights; right in
+  // front of the centre the irradiance is the closed form (tending to pi L).
+  RectangleLight r;
+  r.center = Vec3(0, 0, 1);
+  r.normal = Vec3(0, 0, -1);
+  r.up = Vec3(0, 1, 0);
+  r.width = 2.0;
+  r.height = 2.0;
+  r.radiance = Rgb(1.0);
+  Rng rng(3, 3);
+  for (const Vec3& p : {Vec3(0, 0, 1 - 1e-9), Vec3(0.3, -0.2, 1 - 1e-6), Vec3(2.0, 0.0, 1 - 1e-7)})
+    for (int i = 0; i < 1000; ++i) {
+      LightSample ls;
+      if (!sample_light(Light(r), p, rng.uniform(), rng.uniform(), &ls)) continue;
+      ASSERT_TRUE(is_finite(ls.weight) && std::isfinite(ls.distance) && is_finite(ls.wi));
+    }
+  // The closed form below the centre: four corner rectangles of 1 x 1 at height c, each the form factor
+  // (1 / 2 pi) [A / sqrt(1 + A^2) atan(B / sqrt(1 + A^2)) + (A <-> B)], A = B = 1 / c, times pi L.
+  const double c = 1e-3, A = 1.0 / c, s1 = std::sqrt(1.0 + A * A);
+  const double exact = 4.0 * kPi * (2.0 * A / s1 * std::atan(A / s1)) / (2.0 * kPi);
+  const test::MeanAccumulator e = irradiance(r, Vec3(0, 0, 1 - c), Vec3(0, 0, 1), 20000);
+  EXPECT_NEAR(e.mean, exact, 5.0 * e.stderr_mean());
+  EXPECT_LT(e.stderr_mean(), 0.005 * exact);
+}
+
 TEST(AreaLights, PhotonsCarryTheLightsPowerOutwards) {
   SphereLight s;
   s.center = Vec3(1, 0, 0);
