@@ -78,7 +78,35 @@ struct PointLight {
 struct EnvironmentLight {
   Rgb radiance{1, 1, 1};
 };
-using Light = std::variant<DirectionalLight, PointLight, EnvironmentLight>;
+// A point light limited to a cone (docs/scene-format.md, "spot"): intensity times the smooth edge
+// spot_falloff() (scene/lights.h), with no cosine-to-axis factor. Positions and directions in the world
+// (the light's transform is applied when the scene is read).
+struct SpotLight {
+  Vec3 position{0, 0, 5};
+  Vec3 direction{0, 0, -1};      // the cone's axis, unit
+  Rgb intensity{1, 1, 1};        // W/sr on the axis
+  double cone_angle_deg = 45.0;  // the full angle, in (0, 180]
+  double blend = 0.0;            // in [0, 1]
+};
+// Area lights: a sphere emitting `radiance` outward from every point of its surface, and a one-sided
+// rectangle (`size` across normal x up and along up) emitting along its normal. `power` in the scene is
+// turned into radiance when it is read. `visible`: camera rays see them. They occlude nothing.
+struct SphereLight {
+  Vec3 center{0, 0, 0};
+  double radius = 1.0;
+  Rgb radiance{1, 1, 1};
+  bool visible = false;
+};
+struct RectangleLight {
+  Vec3 center{0, 0, 0};
+  Vec3 normal{0, 0, -1};  // unit; light leaves this side
+  Vec3 up{0, 1, 0};       // unit, perpendicular to normal
+  double width = 1.0, height = 1.0;
+  Rgb radiance{1, 1, 1};
+  bool visible = false;
+};
+using Light =
+    std::variant<DirectionalLight, PointLight, EnvironmentLight, SpotLight, SphereLight, RectangleLight>;
 
 // Opaque surfaces (two-sided). Shapes: an analytic sphere, a rectangle (a quad of `size` across the
 // `up` direction's perpendicular and along `up`, facing `normal`), a box and a triangle mesh from a file.

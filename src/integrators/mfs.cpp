@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include "core/json_reader.h"
+#include "integrators/area_light_view.h"
 #include "integrators/camera_layers.h"
 #include "integrators/mfs_estimators.h"
 #include "integrators/surface_light.h"
@@ -88,9 +89,9 @@ MfsIntegrator::MfsIntegrator(const SceneContext& context, MfsSettings settings, 
   // Disney cloud's precomputation against 0.05.
   constexpr double map_step = 0.25;
   for (const Light& l : ctx_.lights) {
-    full_maps_.emplace_back(ctx_.media, ctx_.majorants, l, s_.shadow_map_resolution, map_step);
-    if (s_.forward_light_path())
-      reduced_maps_.emplace_back(ctx_.media, ctx_.majorants, l, s_.shadow_map_resolution, map_step, f_);
+    const int res = is_area_light(l) ? 8 : s_.shadow_map_resolution;  // area lights: a token map (light_beam)
+    full_maps_.emplace_back(ctx_.media, ctx_.majorants, l, res, map_step);
+    if (s_.forward_light_path()) reduced_maps_.emplace_back(ctx_.media, ctx_.majorants, l, res, map_step, f_);
   }
   if (!s_.scatter_grid_resolution) {
     // "auto": cells of at most ~1.6 optical depths at the medium's typical extinction (the mean of the
@@ -139,7 +140,11 @@ size_t MfsIntegrator::memory_bytes() const {
 // in optical depth (docs/derivations.md: eq. D7 for the first wide scatter and the forward peak, D11 for
 // forward_side "light", D12 for the higher orders, D13 for the growing steps).
 Rgb MfsIntegrator::Li(const Ray& ray, Rng& rng, CameraSample* sample) const {
-  return trace(ray, rng, sample, 1);
+  const Rgb L = trace(ray, rng, sample, 1);
+  if (!has_visible_area_lights(ctx_)) return L;
+  const Rgb Le = visible_area_lights(ctx_, ray, rng, kSurfaceShadowStep);
+  if (sample) sample->direct += Le;  // light straight from a light
+  return L + Le;
 }
 
 Rgb MfsIntegrator::trace(const Ray& ray, Rng& rng, CameraSample* sample, int bounces) const {
@@ -207,7 +212,7 @@ MfsIntegrator::MediumRadiance MfsIntegrator::medium_radiance(int i, const Vec3& 
     if (!sample_light(ctx_.lights[l], p, u1, u2, &ls)) continue;
     if (ctx_.surfaces.occluded(p, ls.wi, ls.distance)) continue;  // a surface shadows y
     const double mu = dot(d, ls.wi);
-    const LightBeam beam = light_beam(l, i, p);
+    const LightBeam beam = light_beam(l, i, p, ls);
     if (s_.light_side()) {
       out.L += light_side_scatter(ls.weight, f, split, mu, beam.tau_ps, beam.T_wide);  // eq. D11
       continue;
@@ -226,9 +231,15 @@ MfsIntegrator::MediumRadiance MfsIntegrator::medium_radiance(int i, const Vec3& 
   return out;
 }
 
-LightBeam MfsIntegrator::light_beam(size_t l, int i, const Vec3& p) const {
-  const Rgb T_light = full_maps_[l].lookup(p);
-  const Rgb T_wide = s_.forward_light_path() ? reduced_maps_[l].lookup(p) : T_light;
+LightBeam MfsIntegrator::light_beam(size_t l, int i, const Vec3& p, const LightSample& ls) const {
+  Rgb T_light, T_wide;
+  if (is_area_light(ctx_.lights[l])) {  // an area light: march to its sampled point instead of a map
+    marched_full_and_reduced(ctx_, p, ls.wi, ls.distance, kSurfaceShadowStep, f_, &T_light, &T_wide);
+    if (!s_.forward_light_path()) T_wide = T_light;
+  } else {
+    T_light = full_maps_[l].lookup(p);
+    T_wide = s_.forward_light_path() ? reduced_maps_[l].lookup(p) : T_light;
+  }
   Rgb R(1.0), mean_cos(1.0);
   const bool traced = beam_ && beam_->lookup(l, p, &R, &mean_cos);
   return peak_only_beam(T_light, T_wide, traced, R, mean_cos, splits_[i]->peak_moments(), theta2_[i],

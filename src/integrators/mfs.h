@@ -131,8 +131,9 @@ class MfsIntegrator final : public Integrator {
   // sample of every light (eqs. D7, D11) and the scatter grid's higher orders (eq. D12).
   MediumRadiance medium_radiance(int i, const Vec3& p, const Vec3& d, double t, const CameraPoint& y,
                                  const CameraPath& cam, Rng& rng) const;
-  // Light l's peak-only beam at p for medium i: shadow maps, beam grid (eqs. D8, D9).
-  LightBeam light_beam(size_t l, int i, const Vec3& p) const;
+  // Light l's peak-only beam at p for medium i: shadow maps, beam grid (eqs. D8, D9); an area light
+  // marches to its sampled point ls instead of reading a map.
+  LightBeam light_beam(size_t l, int i, const Vec3& p, const LightSample& ls) const;
   // The scatter grid's light, taking its last wide scatter at p towards the camera (eq. D12).
   Rgb higher_orders(int i, const Vec3& p, const Vec3& d, double t, const Rgb& tau_p,
                     const CameraPath& cam) const;

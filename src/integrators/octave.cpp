@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "core/json_reader.h"
+#include "integrators/area_light_view.h"
 #include "integrators/camera_layers.h"
 #include "integrators/surface_light.h"
 #include "integrators/tracking.h"
@@ -56,8 +57,8 @@ OctaveIntegrator::OctaveIntegrator(const SceneContext& context, OctaveSettings s
     for (int i = 0; i < ctx_.media.count(); ++i)
       phases_.back().push_back(scale_phase_eccentricity(ctx_.media.phase(i), std::pow(s_.c, j)));
   }
-  for (const Light& l : ctx_.lights)
-    maps_.emplace_back(ctx_.media, ctx_.majorants, l, s_.shadow_map_resolution, 0.05);
+  for (const Light& l : ctx_.lights)  // (area lights: a token map, they march to a sampled point)
+    maps_.emplace_back(ctx_.media, ctx_.majorants, l, is_area_light(l) ? 8 : s_.shadow_map_resolution, 0.05);
 }
 
 Rgb OctaveIntegrator::octave_scatter(int j, double bj, const Vec3& p, const Vec3& d, const MediumPoint& mp,
@@ -94,7 +95,11 @@ Rgb OctaveIntegrator::octave_scatter(int j, double bj, const Vec3& p, const Vec3
 }
 
 Rgb OctaveIntegrator::Li(const Ray& ray, Rng& rng, CameraSample* sample) const {
-  return trace(ray, rng, sample, 1);
+  const Rgb L = trace(ray, rng, sample, 1);
+  if (!has_visible_area_lights(ctx_)) return L;
+  const Rgb Le = visible_area_lights(ctx_, ray, rng, kSurfaceShadowStep);
+  if (sample) sample->direct += Le;  // light straight from a light
+  return L + Le;
 }
 
 Rgb OctaveIntegrator::trace(const Ray& ray, Rng& rng, CameraSample* sample, int bounces) const {
@@ -126,8 +131,12 @@ Rgb OctaveIntegrator::trace(const Ray& ray, Rng& rng, CameraSample* sample, int 
         const double u1 = rng.uniform(), u2 = rng.uniform();
         lights.ok[l] = sample_light(ctx_.lights[l], p, u1, u2, &lights.ls[l]);
         if (lights.ok[l] && ctx_.surfaces.occluded(p, lights.ls[l].wi, lights.ls[l].distance))
-          lights.ok[l] = false;  // a surface shadows p
-        if (lights.ok[l]) lights.T[l] = maps_[l].lookup(p);
+          lights.ok[l] = false;                             // a surface shadows p
+        if (lights.ok[l] && is_area_light(ctx_.lights[l]))  // the sampled point of an area light, marched
+          lights.T[l] = marched_transmittance(ctx_.media, ctx_.majorants, p, lights.ls[l].wi,
+                                              lights.ls[l].distance, kSurfaceShadowStep);
+        else if (lights.ok[l])
+          lights.T[l] = maps_[l].lookup(p);
       }
       // Octave j: scattering a^j sigma_s seen through the camera-side transmittance exp(-b^j tau).
       for (int j = 0; j < N; ++j) {

@@ -52,7 +52,8 @@ class OctaveIntegrator final : public Integrator {
   nlohmann::json settings_json() const override { return to_json(s_); }
 
  private:
-  // One sample of every directional and point light at a march point, with its shadow-map transmittance.
+  // One sample of every light at a march point, with its shadow-map transmittance (an area light's:
+  // marched to the sampled point).
   struct LightSamples {
     std::vector<LightSample> ls;
     std::vector<Rgb> T;

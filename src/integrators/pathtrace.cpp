@@ -1,6 +1,7 @@
 #include "integrators/pathtrace.h"
 
 #include "core/json_reader.h"
+#include "integrators/area_light_view.h"
 #include "integrators/camera_layers.h"
 #include "integrators/surface_light.h"
 #include "integrators/tracking.h"
@@ -214,6 +215,8 @@ Rgb PathTracer::Li(const Ray& ray, Rng& rng, CameraSample* sample) const {
       beta /= q;
     }
   }
+  const Rgb Le = visible_area_lights(ctx_, ray, rng);  // what the camera sees of lights (else NEE only)
+  L += Le, first.direct += Le;
   if (sample) fill_camera_sample(ctx_, first, L, sample);
   return L;
 }

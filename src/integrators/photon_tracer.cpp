@@ -5,6 +5,9 @@
 
 #include <cmath>
 
+#include "scene/area_lights.h"
+#include "scene/lights.h"
+
 namespace nimbus {
 
 Photon emit(const SceneContext& ctx, size_t source, const Vec3& c, double r, double n, Rng& rng,
@@ -24,18 +27,33 @@ Photon emit(const SceneContext& ctx, size_t source, const Vec3& c, double r, dou
       p.w = normalize(d->direction);
       p.x = through_disc(p.w);
       p.power = d->irradiance * (disc_area / n);
-    } else if (const auto* pt = std::get_if<PointLight>(&light)) {
-      const Vec3 v = c - pt->position;
+    } else if (std::holds_alternative<PointLight>(light) || std::holds_alternative<SpotLight>(light)) {
+      // A point light (a spot: times its falloff in the photon's direction) towards the media's sphere.
+      const auto* pt = std::get_if<PointLight>(&light);
+      const auto* spot = std::get_if<SpotLight>(&light);
+      p.x = pt ? pt->position : spot->position;
+      const Vec3 v = c - p.x;
       const double dist = v.length();
-      p.x = pt->position;
-      if (dist > r) {
-        const double cos_max = std::sqrt(std::max(0.0, 1.0 - r * r / (dist * dist)));
+      // The narrower of the cone towards the media's sphere and a spot's own cone (both hold every
+      // direction that carries power into the media).
+      const double cos_aim = dist > r ? std::sqrt(std::max(0.0, 1.0 - r * r / (dist * dist))) : -1.0;
+      const double cos_spot = spot ? std::cos(0.5 * spot->cone_angle_deg * kPi / 180.0) : -1.0;
+      if (cos_spot > cos_aim) {
+        p.w = spherical_direction(1.0 - u1 * (1.0 - cos_spot), 2.0 * kPi * u2, spot->direction);
+        p.power = Rgb(2.0 * kPi * (1.0 - cos_spot) / n);
+      } else if (dist > r) {
+        const double cos_max = cos_aim;
         p.w = spherical_direction(1.0 - u1 * (1.0 - cos_max), 2.0 * kPi * u2, v / dist);
-        p.power = pt->intensity * (2.0 * kPi * (1.0 - cos_max) / n);
+        p.power = Rgb(2.0 * kPi * (1.0 - cos_max) / n);
       } else {
         p.w = spherical_direction(1.0 - 2.0 * u1, 2.0 * kPi * u2, Vec3(0, 0, 1));
-        p.power = pt->intensity * (4.0 * kPi / n);
+        p.power = Rgb(4.0 * kPi / n);
       }
+      p.power *= pt ? pt->intensity : spot->intensity * spot_falloff(*spot, dot(p.w, spot->direction));
+    } else {
+      // An area light: a uniform point of it, a cosine-weighted direction. (Only the beam grid, which
+      // leaves area lights out, passes a stratified sample.)
+      emit_area_photon(light, n, u1, u2, u3, u4, &p.x, &p.w, &p.power);
     }
   } else {
     // Uniform radiance L from every direction: flux L 4 pi A through a disc of area A.

@@ -41,15 +41,13 @@ TransmittanceGrid::TransmittanceGrid(const SceneMedia& media, const MajorantGrid
     for (int y = 0; y < grid_.nodes[1]; ++y) {
       for (int x = 0; x < grid_.nodes[0]; ++x) {
         const Vec3 p = grid_.position(x, y, z);
-        LightSample ls;
         Rgb T(1.0);
-        // The centre of the light (a sun disc is treated as its centre direction here).
-        if (const auto* d = std::get_if<DirectionalLight>(&light)) {
-          T = marched_transmittance(media, grid, p, -d->direction, std::numeric_limits<double>::infinity(),
-                                    tau_step, peak_fraction);
-        } else if (sample_light(light, p, 0.5, 0.5, &ls)) {
-          T = marched_transmittance(media, grid, p, ls.wi, ls.distance, tau_step, peak_fraction);
-        }
+        // The centre of the light (a sun disc is treated as its centre direction here; a spot's map
+        // covers its whole sphere of directions, the cone is applied by sample_light).
+        Vec3 wi;
+        double distance = 0.0;
+        if (light_centre(light, p, &wi, &distance))
+          T = marched_transmittance(media, grid, p, wi, distance, tau_step, peak_fraction);
         float* v = &values_[grid_.index(x, y, z) * 3];
         for (int c = 0; c < 3; ++c) v[c] = float(T[c]);
       }

@@ -1,6 +1,7 @@
 // A deep shadow map: per light, a grid of transmittance towards the light over the media's bounds,
 // built once by a deterministic midpoint march in optical-depth steps and read back with trilinear
-// interpolation (PVR's cached-transmittance occluder). For directional and point lights.
+// interpolation (PVR's cached-transmittance occluder). For directional, point and spot lights (towards
+// light_centre); area lights are marched to a sampled point instead (integrators/area_light_view.h).
 #pragma once
 
 #include <vector>

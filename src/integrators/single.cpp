@@ -1,6 +1,7 @@
 #include "integrators/single.h"
 
 #include "core/json_reader.h"
+#include "integrators/area_light_view.h"
 #include "integrators/camera_layers.h"
 #include "integrators/surface_light.h"
 #include "integrators/tracking.h"
@@ -34,19 +35,26 @@ nlohmann::json to_json(const SingleSettings& s) {
 SingleScatter::SingleScatter(const SceneContext& context, SingleSettings settings)
     : ctx_(context), s_(settings) {
   if (s_.transmittance == Transmittance::shadow_map) {
-    for (const Light& l : ctx_.lights)
-      shadow_maps_.emplace_back(ctx_.media, ctx_.majorants, l, s_.shadow_map_resolution, 0.05);
+    for (const Light& l : ctx_.lights)  // (area lights: a token map, they march to a sampled point)
+      shadow_maps_.emplace_back(ctx_.media, ctx_.majorants, l,
+                                is_area_light(l) ? 8 : s_.shadow_map_resolution, 0.05);
   }
 }
 
 Rgb SingleScatter::light_transmittance(size_t l, const Vec3& p, const LightSample& ls, Rng& rng) const {
+  if (!shadow_maps_.empty() && is_area_light(ctx_.lights[l]))  // the sampled point, marched
+    return shadow_transmittance(ctx_, p, ls.wi, ls.distance, rng, kSurfaceShadowStep);
   if (!shadow_maps_.empty())
     return ctx_.surfaces.occluded(p, ls.wi, ls.distance) ? Rgb(0.0) : shadow_maps_[l].lookup(p);
   return shadow_transmittance(ctx_, p, ls.wi, ls.distance, rng);
 }
 
 Rgb SingleScatter::Li(const Ray& ray, Rng& rng, CameraSample* sample) const {
-  return trace(ray, rng, sample, 1);
+  const Rgb L = trace(ray, rng, sample, 1);
+  if (!has_visible_area_lights(ctx_)) return L;
+  const Rgb Le = visible_area_lights(ctx_, ray, rng, shadow_maps_.empty() ? 0.0 : kSurfaceShadowStep);
+  if (sample) sample->direct += Le;  // light straight from a light
+  return L + Le;
 }
 
 Rgb SingleScatter::trace(const Ray& ray, Rng& rng, CameraSample* sample, int bounces) const {

@@ -11,7 +11,7 @@
 // |-------------------------|---------------------------|---------|-------------------------------------------|
 // | `tau_step`              | number in [1e-4, 100]     | 0.1     | optical depth per march step against the local majorant |
 // | `light_samples`         | integer in [1, 1024]      | 1       | transmittance estimates per light per step |
-// | `transmittance`         | "ratio" or "shadow_map"   | "ratio" | to directional and point lights: exact ratio tracking, or a deep shadow map (deterministic, biased by its resolution); the environment always uses ratio tracking |
+// | `transmittance`         | "ratio" or "shadow_map"   | "ratio" | to the lights: exact ratio tracking, or a deep shadow map (deterministic, biased by its resolution) for directional, point and spot lights and a march to a sampled point for area lights; the environment always uses ratio tracking |
 // | `shadow_map_resolution` | integer in [8, 1024]      | 128     | shadow map nodes along the longest axis of the media's bounds |
 #pragma once
 

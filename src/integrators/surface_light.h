@@ -19,9 +19,9 @@ inline constexpr double kSurfaceShadowStep = 0.1;
 Rgb shadow_transmittance(const SceneContext& ctx, const Vec3& p, const Vec3& w, double tmax, Rng& rng,
                          double march_step = 0.0);
 
-// (albedo / pi) times the cosine-weighted irradiance at a diffuse surface point from every directional and
-// point light (light sampling, one sample each), through shadow_transmittance. hit.ns faces the viewer;
-// the surface is two-sided, lit on the viewer's side only.
+// (albedo / pi) times the cosine-weighted irradiance at a diffuse surface point from every directional,
+// point, spot and area light (light sampling, one sample each), through shadow_transmittance. hit.ns
+// faces the viewer; the surface is two-sided, lit on the viewer's side only.
 Rgb surface_direct_light(const SceneContext& ctx, const SurfaceHit& hit, const Rgb& albedo, Rng& rng,
                          double march_step = 0.0);
 

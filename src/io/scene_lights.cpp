@@ -3,6 +3,7 @@
 
 #include <fmt/format.h>
 
+#include "io/scene_area_lights.h"
 #include "io/scene_fields.h"
 
 namespace nimbus {
@@ -26,8 +27,16 @@ Light parse_light(JsonObject o, const std::filesystem::path& base_dir) {
     EnvironmentLight e;
     e.radiance = o.rgb("radiance", 0.0);
     light = e;
+  } else if (type == "spot") {
+    light = parse_spot_light(o);
+  } else if (type == "sphere") {
+    light = parse_sphere_light(o);
+  } else if (type == "rectangle") {
+    light = parse_rectangle_light(o);
   } else {
-    o.fail("type", fmt::format("unknown light '{}' (known: directional, point, environment)", type));
+    o.fail("type", fmt::format("unknown light '{}' (known: directional, point, environment, spot, sphere, "
+                               "rectangle)",
+                               type));
   }
   o.finish();
   return light;

@@ -19,7 +19,7 @@ struct SceneContext {
   MajorantGrid majorants;
   SceneSurfaces surfaces;
   PinholeCamera camera;
-  std::vector<Light> lights;  // directional and point lights (sampled by NEE)
+  std::vector<Light> lights;  // every light but the environment (sampled by NEE)
   Rgb environment{0.0};       // sum of environment lights' radiance
   bool has_environment = false;
 };

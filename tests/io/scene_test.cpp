@@ -93,8 +93,9 @@ TEST(Scene, BadInputCatalogue) {
       {"/lights/0/direction", json::array({0, 1}), false,
        "scene.json: /lights/0/direction: must be an array of 3 numbers"},
       {"/lights/0/irradiance", -1.0, false, "scene.json: /lights/0/irradiance: must be >= 0"},
-      {"/lights/1/type", "spot", false,
-       "scene.json: /lights/1/type: unknown light 'spot' (known: directional, point, environment)"},
+      {"/lights/1/type", "torch", false,
+       "scene.json: /lights/1/type: unknown light 'torch' (known: directional, point, environment, spot, "
+       "sphere, rectangle)"},
       {"/camera/width", 0, false, "scene.json: /camera/width: must be >= 1"},
       {"/camera/width", 12.5, false, "scene.json: /camera/width: must be a whole number"},
       {"/camera/height", 20000, false, "scene.json: /camera/height: must be <= 16384"},

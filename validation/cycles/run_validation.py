@@ -57,7 +57,7 @@ def render_all(args, scenes, work, log):
             dt, out = run(["nice", "-n", "10", args.blender, "-b", "--factory-startup",
                            "--python-exit-code", "1", "--python", HERE / "scene_to_blender.py", "--",
                            path, cexr, "--samples", str(args.cycles_samples), "--seed", str(seed),
-                           "--threads", str(args.threads), "--npy", work / f"{name}_cycles_s{seed}.npy"], log)
+                           "--threads", str(args.threads), "--sphere-lights", args.sphere_lights, "--npy", work / f"{name}_cycles_s{seed}.npy"], log)
             t["cycles_s"] += dt
             m = re.search(r"^scene_to_blender: (.*)$", out, re.M)
             if m:
@@ -181,6 +181,8 @@ def main():
     p.add_argument("--threads", type=int, default=2, help="Cycles threads")
     p.add_argument("--nimbus", default=str(ROOT / "build" / "bin" / "nimbus"))
     p.add_argument("--blender", default="blender")
+    p.add_argument("--sphere-lights", choices=["lamp", "mesh"], default="mesh",
+                   help="how scene_to_blender.py builds sphere lights (see its --sphere-lights)")
     p.add_argument("--work", default=str(ROOT / "build" / "validation-cycles"))
     p.add_argument("--docs", default=str(ROOT / "docs" / "validation"))
     p.add_argument("--skip-render", action="store_true", help="reuse the renders in --work")

@@ -28,6 +28,8 @@ Mapping (docs/validation/cycles.md explains and checks each line):
   directional  SUN lamp, Strength = irradiance (W/m^2), Color = irradiance / max, angle = angular
                diameter (use 0: Cycles' disc radiance is S/(pi tan^2(a/2)), nimbus' S/(pi sin^2(a/2))).
   point        POINT lamp, radius 0, Power P = 4 pi I (Cycles: I = P / (4 pi) W/sr, eval_fac = 1/(4 pi)).
+  spot, sphere, rectangle: see build_area_or_spot_light (sphere: build_sphere_light_mesh by default,
+               --sphere-lights lamp for a POINT lamp of radius r).
   environment  World Background, Color = radiance, Strength 1 (black world without one).
   integrator   max_events 0 -> volume bounces 1024; max_events k -> volume bounces k - 1.
 """
@@ -55,6 +57,9 @@ def parse_args():
                    help="UV sphere segments around (rings = segments / 2)")
     p.add_argument("--npy", default=None, help="also save the pixels as (h, w, 3) float32 .npy")
     p.add_argument("--blend", default=None, help="also save the built .blend (debugging)")
+    p.add_argument("--sphere-lights", choices=["lamp", "mesh"], default="mesh",
+                   help="sphere lights as emissive, transparent UV spheres (default: exact up to tessellation) "
+                        "or as POINT lamps of radius r (Cycles 3.4 samples a disc: dimmer nearby)")
     p.add_argument("--allow-multi-lobe", action="store_true",
                    help="render double_hg as two Volume Scatter closures although Cycles 3.4 gets it wrong")
     return p.parse_args(argv)
@@ -336,7 +341,7 @@ def build_media(media, segments):
 
 
 # --- Lights -----------------------------------------------------------------------------------
-def build_lights(lights):
+def build_lights(lights, sphere_lights="mesh", segments=256):
     scene = bpy.context.scene
     world = bpy.data.worlds.new("world")
     world.use_nodes = True
@@ -363,11 +368,129 @@ def build_lights(lights):
             data.shadow_soft_size = 0.0
             obj = link(bpy.data.objects.new(f"point{i}", data))
             obj.location = Vector(light["position"])
+        elif kind == "sphere" and sphere_lights == "mesh":
+            build_sphere_light_mesh(i, light, segments)
+        elif kind in ("spot", "sphere", "rectangle"):
+            build_area_or_spot_light(i, light)
         elif kind == "environment":
             bg.inputs["Color"].default_value = (*rgb(light["radiance"]), 1.0)
             bg.inputs["Strength"].default_value = 1.0
         else:
             raise ValueError(f"light {i}: type '{kind}' is not supported")
+
+
+def spot_without_cosine(data, axis):
+    """A light node tree dividing the emission by the cosine to the spot's axis, which Cycles 3.4 applies
+    on top of the smoothstep edge (spot_light_attenuation: attenuation = dot(dir, N) * smoothstep(...)).
+    In a lamp's shader the Geometry Normal is the lamp's Ng = the direction from the lamp to the shaded
+    point (kernel/light/light.h: ls->Ng = -ls->D)."""
+    data.use_nodes = True
+    nt = data.node_tree
+    emission = nt.nodes["Emission"]
+    geometry = nt.nodes.new("ShaderNodeNewGeometry")
+    dot = nt.nodes.new("ShaderNodeVectorMath")
+    dot.operation = "DOT_PRODUCT"
+    dot.inputs[1].default_value = tuple(axis)
+    clamp = nt.nodes.new("ShaderNodeMath")
+    clamp.operation = "MAXIMUM"
+    clamp.inputs[1].default_value = 1e-4
+    inverse = nt.nodes.new("ShaderNodeMath")
+    inverse.operation = "DIVIDE"
+    inverse.inputs[0].default_value = 1.0
+    nt.links.new(geometry.outputs["Normal"], dot.inputs[0])
+    nt.links.new(dot.outputs["Value"], clamp.inputs[0])
+    nt.links.new(clamp.outputs["Value"], inverse.inputs[1])
+    nt.links.new(inverse.outputs["Value"], emission.inputs["Strength"])
+
+
+def build_sphere_light_mesh(i, light, segments):
+    """A sphere light as a UV sphere (equal volume) whose front faces emit `radiance` (Emission strength 1
+    = radiance 1) and which every ray passes through (Transparent BSDF), like nimbus' sphere light: it
+    emits outward only and occludes nothing. Seen by the camera only if `visible`."""
+    T = transform_matrix(light.get("transform"))
+    r = light["radius"] * T.to_3x3().col[0].length
+    L = rgb(light["radiance"]) if "radiance" in light else \
+        tuple(p / (4.0 * math.pi ** 2 * r * r) for p in rgb(light["power"]))
+    mesh, _ = sphere_mesh(f"sphere_light{i}", r, segments)
+    obj = link(bpy.data.objects.new(f"sphere_light{i}", mesh))
+    obj.location = T @ Vector(light["center"])
+    for poly in mesh.polygons:
+        poly.use_smooth = True
+    mat = bpy.data.materials.new(f"sphere_light{i}")
+    mat.use_nodes = True
+    nt = mat.node_tree
+    nt.nodes.clear()
+    out = nt.nodes.new("ShaderNodeOutputMaterial")
+    emission = nt.nodes.new("ShaderNodeEmission")
+    emission.inputs["Color"].default_value = (*L, 1.0)
+    emission.inputs["Strength"].default_value = 1.0
+    through = nt.nodes.new("ShaderNodeBsdfTransparent")
+    through2 = nt.nodes.new("ShaderNodeBsdfTransparent")
+    add = nt.nodes.new("ShaderNodeAddShader")
+    mix = nt.nodes.new("ShaderNodeMixShader")
+    geometry = nt.nodes.new("ShaderNodeNewGeometry")
+    nt.links.new(emission.outputs[0], add.inputs[0])
+    nt.links.new(through.outputs[0], add.inputs[1])
+    nt.links.new(geometry.outputs["Backfacing"], mix.inputs["Fac"])
+    nt.links.new(add.outputs[0], mix.inputs[1])  # front faces: emission + transparent
+    nt.links.new(through2.outputs[0], mix.inputs[2])  # back faces: transparent
+    nt.links.new(mix.outputs[0], out.inputs["Surface"])
+    mesh.materials.append(mat)
+    obj.visible_camera = bool(light.get("visible", False))
+    obj.visible_shadow = True
+
+
+def build_area_or_spot_light(i, light):
+    """spot: SPOT lamp, radius 0, Power = 4 pi I, spot_size = cone angle, spot_blend = blend, the cosine
+    factor divided out (spot_without_cosine). sphere: POINT lamp of radius r, Power = 4 pi^2 r^2 L
+    (Cycles: L = P / (4 pi) / (pi r^2)), which Cycles 3.4 samples as a disc facing the shaded point.
+    rectangle: AREA lamp (RECTANGLE, size x = width along normal x up, y = height along up), emitting
+    along its local -Z; Power = 4 A L (Cycles 3.4: L = P / (4 A), kernel/light/light.h eval_fac = 1/4
+    invarea; checked in docs/validation/cycles.md). visible -> the object's camera visibility."""
+    kind = light["type"]
+    T = transform_matrix(light.get("transform"))
+    if kind == "spot":
+        color, scale = color_and_scale(light["intensity"])
+        data = bpy.data.lights.new(f"spot{i}", "SPOT")
+        data.energy = 4.0 * math.pi * scale
+        data.spot_size = math.radians(light["cone_angle_deg"])
+        data.spot_blend = light.get("blend", 0.0)
+        data.shadow_soft_size = 0.0
+        axis = (T.to_3x3() @ Vector(light["direction"])).normalized()
+        spot_without_cosine(data, axis)
+        obj = link(bpy.data.objects.new(f"spot{i}", data))
+        obj.location = T @ Vector(light["position"])
+        obj.rotation_euler = axis.to_track_quat("-Z", "Y").to_euler()  # spots shine down local -Z
+        data.color = color
+        return
+    color, scale = color_and_scale(light["radiance"]) if "radiance" in light else (None, None)
+    if kind == "sphere":
+        r = light["radius"] * T.to_3x3().col[0].length
+        if scale is None:
+            color, scale = color_and_scale([p / (4.0 * math.pi ** 2 * r * r) for p in rgb(light["power"])])
+        data = bpy.data.lights.new(f"sphere{i}", "POINT")
+        data.shadow_soft_size = r
+        data.energy = 4.0 * math.pi ** 2 * r * r * scale
+        obj = link(bpy.data.objects.new(f"sphere{i}", data))
+        obj.location = T @ Vector(light["center"])
+    else:
+        s = T.to_3x3().col[0].length
+        w, h = light["size"][0] * s, light["size"][1] * s
+        if scale is None:
+            color, scale = color_and_scale([p / (math.pi * w * h) for p in rgb(light["power"])])
+        n = (T.to_3x3() @ Vector(light["normal"])).normalized()
+        up = T.to_3x3() @ Vector(light.get("up", [0, 1, 0]))
+        up = (up - n * up.dot(n)).normalized()
+        data = bpy.data.lights.new(f"rect{i}", "AREA")
+        data.shape = "RECTANGLE"
+        data.size, data.size_y = w, h
+        data.energy = 4.0 * w * h * scale
+        obj = link(bpy.data.objects.new(f"rect{i}", data))
+        # Local -Z = normal, local +Y = up, so local +X = up x (-normal) = normal x up (nimbus' width axis).
+        obj.matrix_world = Matrix.Translation(T @ Vector(light["center"])) @ \
+            Matrix((n.cross(up), up, -n)).transposed().to_4x4()
+    data.color = color
+    obj.visible_camera = bool(light.get("visible", False))
 
 
 # --- Render settings --------------------------------------------------------------------------
@@ -445,7 +568,7 @@ def main():
     mesh_info = build_media(scene_json.get("media", []), args.sphere_segments)
     mesh_info += build_surfaces(scene_json.get("surfaces", []), args.sphere_segments,
                                 Path(args.scene).resolve().parent)
-    build_lights(scene_json.get("lights", []))
+    build_lights(scene_json.get("lights", []), args.sphere_lights, args.sphere_segments)
     configure(args, scene_json.get("integrator", {}))
     print("scene_to_blender:", json.dumps({"camera": cam_info, "media": mesh_info,
                                            "samples": bpy.context.scene.cycles.samples,

@@ -1,0 +1,57 @@
+// The visible area lights (integrators/area_light_view.h).
+#include "integrators/area_light_view.h"
+
+#include <limits>
+
+#include "integrators/surface_light.h"
+#include "integrators/tracking.h"
+#include "scene/area_lights.h"
+
+namespace nimbus {
+
+namespace {
+bool is_visible(const Light& light) {
+  if (const auto* s = std::get_if<SphereLight>(&light)) return s->visible;
+  if (const auto* r = std::get_if<RectangleLight>(&light)) return r->visible;
+  return false;
+}
+}  // namespace
+
+bool has_visible_area_lights(const SceneContext& ctx) {
+  for (const Light& light : ctx.lights)
+    if (is_visible(light)) return true;
+  return false;
+}
+
+Rgb visible_area_lights(const SceneContext& ctx, const Ray& ray, Rng& rng, double march_step) {
+  Rgb L(0.0);
+  for (const Light& light : ctx.lights) {
+    double t = 0.0;
+    Rgb Le;
+    if (!is_visible(light) ||
+        !hit_area_light(light, ray.o, ray.d, std::numeric_limits<double>::infinity(), &t, &Le))
+      continue;
+    L += Le * shadow_transmittance(ctx, ray.o, ray.d, t, rng, march_step);
+  }
+  return L;
+}
+
+void marched_full_and_reduced(const SceneContext& ctx, const Vec3& p, const Vec3& w, double tmax,
+                              double tau_step, const std::vector<double>& peak_fraction, Rgb* T_full,
+                              Rgb* T_reduced) {
+  Rgb tau(0.0), tau_reduced(0.0);
+  MediumPoint mp;
+  march(ctx.majorants, p, w, tmax, tau_step, 0.5, [&](const Vec3& x, double, double dt) {
+    ctx.media.eval(x, &mp);
+    Rgb reduced = mp.sigma_t();
+    tau += reduced * dt;
+    for (int i = 0; i < mp.count && i < int(peak_fraction.size()); ++i)
+      reduced -= mp.sigma_s_i[i] * peak_fraction[i];
+    tau_reduced += reduced * dt;
+    return min_component(tau_reduced) < 50.0;
+  });
+  *T_full = exp(-tau);
+  *T_reduced = exp(-tau_reduced);
+}
+
+}  // namespace nimbus
