@@ -8,6 +8,18 @@
 
 namespace nimbus {
 
+namespace {
+// Set while a surface gathers its one ray (surface_radiance with a gather) in a scene with an environment
+// image: that surface took the image's light by MIS already, so the gathered ray's escape shows only the
+// constant environment. Per thread: an integrator's Li runs on one thread, the gather inside it.
+thread_local bool t_env_map_taken = false;
+struct EnvMapTakenHere {
+  bool saved;
+  explicit EnvMapTakenHere(bool taken) : saved(t_env_map_taken) { t_env_map_taken = taken; }
+  ~EnvMapTakenHere() { t_env_map_taken = saved; }
+};
+}  // namespace
+
 Rgb shadow_transmittance(const SceneContext& ctx, const Vec3& p, const Vec3& w, double tmax, Rng& rng,
                          double march_step) {
   if (ctx.surfaces.occluded(p, w, tmax)) return Rgb(0.0);
@@ -37,14 +49,18 @@ Rgb surface_radiance(const SceneContext& ctx, const SurfaceHit& hit, Rng& rng, c
   Rgb L = surface_direct_light(ctx, hit, diffuse->albedo, rng, march_step);
   if (direct_part) *direct_part = L;
   if (!gather && !ctx.has_environment) return L;
-  // Without a gather, the environment image by MIS (integrators/env_light.h), then the constant one.
-  if (!gather && ctx.env_map) L += diffuse->albedo * surface_env_map_light(ctx, hit, rng, march_step);
+  // The environment image by MIS (integrators/env_light.h); a gathered ray then leaves it out where it
+  // escapes (EnvMapTakenHere), so that it is counted once.
+  if (ctx.env_map) L += diffuse->albedo * surface_env_map_light(ctx, hit, rng, march_step);
   if (!gather && !ctx.constant_environment()) return L;
   const double u1 = rng.uniform(), u2 = rng.uniform();
   const Vec3 wi = cosine_direction(hit.ns, u1, u2);
   if (dot(hit.ng, wi) <= 0.0) return L;
   const Vec3 o = SceneSurfaces::offset(hit, wi);
-  if (gather) return L + diffuse->albedo * (*gather)(Ray{o, wi});
+  if (gather) {
+    const EnvMapTakenHere taken(ctx.env_map != nullptr);
+    return L + diffuse->albedo * (*gather)(Ray{o, wi});
+  }
   return L + diffuse->albedo * ctx.environment *
                  shadow_transmittance(ctx, o, wi, std::numeric_limits<double>::infinity(), rng, march_step);
 }
@@ -67,7 +83,10 @@ Rgb surface_env_map_light(const SceneContext& ctx, const SurfaceHit& hit, Rng& r
 Rgb ray_end_radiance(const SceneContext& ctx, const SurfaceHit* hit, const Vec3& d, const Rgb& T, Rng& rng,
                      CameraSample* sample, const GatherFn* gather, Rgb* direct_part, double march_step) {
   if (direct_part) *direct_part = Rgb(0.0);
-  if (!hit) return ctx.has_environment ? T * ctx.environment_radiance(d) : Rgb(0.0);
+  if (!hit) {
+    if (!ctx.has_environment) return Rgb(0.0);
+    return T * (t_env_map_taken ? ctx.environment : ctx.environment_radiance(d));
+  }
   if (sample) record_surface_hit(ctx, *hit, T, sample);
   if (max_component(T) <= 0.0) return Rgb(0.0);
   Rgb direct(0.0);

@@ -34,7 +34,8 @@ Rgb surface_direct_light(const SceneContext& ctx, const SurfaceHit& hit, const R
 // albedo times the radiance arriving along one cosine-sampled direction (weight albedo: (albedo / pi)
 // cos / (cos / pi)). `gather(ray)` is that radiance as the integrator itself computes it along a ray (the
 // medium's scattered light, the environment and surfaces behind, with their direct light); without a
-// gather (nullptr), only the environment through the media is gathered (an image by surface_env_map_light).
+// gather (nullptr), only the environment through the media is gathered. An environment image is taken by
+// surface_env_map_light (MIS) in both cases, and the gathered ray's own escape then leaves it out.
 using GatherFn = std::function<Rgb(const Ray&)>;
 // *direct_part (when given) receives the lights' direct part of the result.
 Rgb surface_radiance(const SceneContext& ctx, const SurfaceHit& hit, Rng& rng, const GatherFn* gather,
