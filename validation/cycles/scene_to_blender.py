@@ -28,7 +28,11 @@ Mapping (docs/validation/cycles.md explains and checks each line):
   directional  SUN lamp, Strength = irradiance (W/m^2), Color = irradiance / max, angle = angular
                diameter (use 0: Cycles' disc radiance is S/(pi tan^2(a/2)), nimbus' S/(pi sin^2(a/2))).
   point        POINT lamp, radius 0, Power P = 4 pi I (Cycles: I = P / (4 pi) W/sr, eval_fac = 1/(4 pi)).
-  environment  World Background, Color = radiance, Strength 1 (black world without one).
+  environment  World Background, Color = radiance, Strength 1 (black world without one). An image
+               (`file`): Environment Texture node, EQUIRECTANGULAR, interpolation Closest (nimbus
+               reads the nearest pixel), colour space Linear, Strength = intensity; its `transform`
+               rotation R (world = R map) through a Mapping node (POINT) rotating the lookup
+               direction by R^-1 (Generated coordinates of the world = the ray direction).
   integrator   max_events 0 -> volume bounces 1024; max_events k -> volume bounces k - 1.
 """
 import argparse
@@ -336,7 +340,28 @@ def build_media(media, segments):
 
 
 # --- Lights -----------------------------------------------------------------------------------
-def build_lights(lights):
+def environment_image(world, bg, light, scene_dir):
+    """An environment image light: Texture Coordinate (Generated) -> Mapping (R^-1) -> Environment
+    Texture -> Background, Strength = intensity."""
+    nodes, links = world.node_tree.nodes, world.node_tree.links
+    path = Path(light["file"])
+    path = path if path.is_absolute() else scene_dir / path
+    tex = nodes.new("ShaderNodeTexEnvironment")
+    tex.image = bpy.data.images.load(str(path))
+    tex.image.colorspace_settings.name = "Linear"
+    tex.interpolation = "Closest"
+    tex.projection = "EQUIRECTANGULAR"
+    coords = nodes.new("ShaderNodeTexCoord")
+    mapping = nodes.new("ShaderNodeMapping")
+    mapping.vector_type = "POINT"
+    mapping.inputs["Rotation"].default_value = transform_matrix(light.get("transform")).to_3x3().inverted().to_euler("XYZ")
+    links.new(coords.outputs["Generated"], mapping.inputs["Vector"])
+    links.new(mapping.outputs["Vector"], tex.inputs["Vector"])
+    links.new(tex.outputs["Color"], bg.inputs["Color"])
+    bg.inputs["Strength"].default_value = float(light.get("intensity", 1.0))
+
+
+def build_lights(lights, scene_dir):
     scene = bpy.context.scene
     world = bpy.data.worlds.new("world")
     world.use_nodes = True
@@ -363,6 +388,8 @@ def build_lights(lights):
             data.shadow_soft_size = 0.0
             obj = link(bpy.data.objects.new(f"point{i}", data))
             obj.location = Vector(light["position"])
+        elif kind == "environment" and "file" in light:
+            environment_image(world, bg, light, scene_dir)
         elif kind == "environment":
             bg.inputs["Color"].default_value = (*rgb(light["radiance"]), 1.0)
             bg.inputs["Strength"].default_value = 1.0
@@ -445,7 +472,7 @@ def main():
     mesh_info = build_media(scene_json.get("media", []), args.sphere_segments)
     mesh_info += build_surfaces(scene_json.get("surfaces", []), args.sphere_segments,
                                 Path(args.scene).resolve().parent)
-    build_lights(scene_json.get("lights", []))
+    build_lights(scene_json.get("lights", []), Path(args.scene).resolve().parent)
     configure(args, scene_json.get("integrator", {}))
     print("scene_to_blender:", json.dumps({"camera": cam_info, "media": mesh_info,
                                            "samples": bpy.context.scene.cycles.samples,
