@@ -10,7 +10,10 @@
 
 #include <fstream>
 
+#include "core/sh.h"
 #include "integrators/env_light.h"
+#include "integrators/mfs.h"
+#include "integrators/registry.h"
 #include "integrators/surface_light.h"
 #include "io/scene_environment.h"
 #include "nimbus/error.h"
@@ -144,6 +147,40 @@ TEST(EnvMapRender, RealSkyMisBeatsPhaseSampling) {
     EXPECT_LT(mis.variance(), 0.5 * plain.variance());
     std::printf("sunrise sky, HG 0.85: exact %.4g, MIS %.4g, variance MIS %.4g, phase sampling %.4g\n", exact,
                 mis.mean, mis.variance(), plain.variance());
+  }
+}
+
+TEST(EnvMapRender, ScatterGridHoldsTheImagesMoments) {
+  // mfs's scatter grid in a nearly empty box (photons fly straight): at its centre the moments of the
+  // photons that left the image by luminance are the image's own spherical-harmonic moments (with
+  // the travel direction -w: L_lm = (-1)^l M_lm), so sum_lm L_lm Y_lm(w_out) = sum_lm M_lm Y_lm(-w_out).
+  // 3 %: the grid's photon noise at 4 nodes across and 2^19 photons (observed within 1.4 %).
+  const test::ScratchDir dir("envmap");
+  const int W = 64, H = 32;
+  const std::string file = write_map(dir, "tilt.exr", W, H, [&](int, int j) {
+    return Rgb(1.0 + 0.6 * std::cos(kPi * (j + 0.5) / H), 1.0, 1.0);
+  });
+  const Scene scene = test::scene_from_json("{" + test::camera_json() +
+                                            fmt::format(R"(,
+    "media": [{{"shape": {{"type": "box", "min": [-1, -1, -1], "max": [1, 1, 1]}}, "sigma_s": 1e-9}}],
+    "lights": [{{"type": "environment", "file": "{}", "transform": {{"rotate": [{{"axis": [1, 0, 0], "degrees": 60}}]}}}}],
+    "integrator": {{"type": "mfs", "photons": 524288, "scatter_grid_resolution": 4}}}})",
+                                                        file));
+  const SceneContext ctx(scene);
+  const auto mfs = make_integrator(ctx, scene.integrator);
+  const ScatterGrid* grid = dynamic_cast<const MfsIntegrator&>(*mfs).scatter_grid();
+  ASSERT_NE(grid, nullptr);
+  const std::vector<Rgb> M = ctx.env_map->sh_moments(3);
+  std::array<Rgb, kShMaxBands> chi;
+  chi.fill(Rgb(1.0));
+  for (const Vec3& w_out :
+       {Vec3(0, 0, 1), Vec3(0, 0, -1), normalize(Vec3(0, 1, 1)), normalize(Vec3(1, -1, 0))}) {
+    double y[9];
+    sh_eval(-w_out, 3, y);
+    double expected = 0.0;
+    for (int h = 0; h < 9; ++h) expected += M[h].x * y[h];
+    const double got = grid->scattered(Vec3(0.01, -0.02, 0.03), w_out, chi).x;
+    EXPECT_NEAR(got, expected, 0.03 * expected) << w_out.x << " " << w_out.y << " " << w_out.z;
   }
 }
 
