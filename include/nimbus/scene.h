@@ -17,6 +17,7 @@
 namespace nimbus {
 
 class DensityGrid;
+class EnvMap;
 class TriangleMesh;
 
 // Pinhole camera. fov_y_deg is the full vertical field of view; image row 0 is the top;
@@ -74,9 +75,15 @@ struct PointLight {
   Vec3 position{0, 0, 5};
   Rgb intensity{1, 1, 1};  // W/sr
 };
-// Constant radiance from every direction; also what the camera sees where its ray escapes.
+// Constant radiance from every direction, or (`file`) a lat-long HDR image around the scene
+// (src/scene/env_map.h: Blender's orientation, `transform` rotations, times `intensity`); also what the
+// camera sees where its ray escapes.
 struct EnvironmentLight {
-  Rgb radiance{1, 1, 1};
+  Rgb radiance{1, 1, 1};              // 0 for an image
+  std::string file;                   // as written in the scene (empty: constant radiance)
+  double intensity = 1.0;             // multiplies the image
+  Transform transform;                // rotations only
+  std::shared_ptr<const EnvMap> map;  // loaded by load_scene
 };
 // A point light limited to a cone (docs/scene-format.md, "spot"): intensity times the smooth edge
 // spot_falloff() (scene/lights.h), with no cosine-to-axis factor. Positions and directions in the world

@@ -35,8 +35,8 @@ void march_depth(const SceneMedia& media, const MajorantGrid& grid, const Vec3& 
 // Records the march of the camera ray (single, octave, mfs) into a CameraSample; with a null sample
 // every call is a no-op. step(): one march step from t0 to t0 + dt over which the transmittance the
 // background is seen through falls from T0 to T1, mp the coefficients at its march point, L_step the
-// radiance the step adds to Li. finish(): the transmittance the background is seen through and the light
-// scattered once (direct = that plus the background).
+// radiance the step adds to Li. finish(): the camera ray's direction d, the transmittance the background
+// is seen through and the light scattered once (direct = that plus the background).
 class MarchRecorder {
  public:
   explicit MarchRecorder(CameraSample* sample) : s_(sample) {}
@@ -51,10 +51,10 @@ class MarchRecorder {
     if (s_->deep && (m0 != m1 || max_component(L_step) > 0.0))
       s_->deep->push_back({t0, t0 + dt, L_step, m0 - m1});
   }
-  void finish(const SceneContext& ctx, const Rgb& T_escape, const Rgb& direct_scattered) {
+  void finish(const SceneContext& ctx, const Vec3& d, const Rgb& T_escape, const Rgb& direct_scattered) {
     if (!s_) return;
     s_->escape_transmittance = T_escape;
-    s_->background = ctx.has_environment ? T_escape * ctx.environment : Rgb(0.0);
+    s_->background = ctx.has_environment ? T_escape * ctx.environment_radiance(d) : Rgb(0.0);
     s_->direct = direct_scattered + s_->background;
   }
   bool active() const { return s_ != nullptr; }

@@ -193,9 +193,9 @@ Rgb MfsIntegrator::trace(const Ray& ray, Rng& rng, CameraSample* sample, int bou
   const Rgb T_end = s_.light_side() ? cam.T_full : cam.T_red;
   const GatherFn gather = [&](const Ray& r) { return trace(r, rng, nullptr, bounces - 1); };
   Rgb surface_direct;
-  const Rgb L_end = ray_end_radiance(ctx_, on_surface ? &hit : nullptr, T_end, rng, sample,
+  const Rgb L_end = ray_end_radiance(ctx_, on_surface ? &hit : nullptr, d, T_end, rng, sample,
                                      bounces > 0 ? &gather : nullptr, &surface_direct, kSurfaceShadowStep);
-  layers.finish(ctx_, on_surface ? Rgb(0.0) : T_end, direct + surface_direct);
+  layers.finish(ctx_, d, on_surface ? Rgb(0.0) : T_end, direct + surface_direct);
   return L + L_end;
 }
 

@@ -5,6 +5,7 @@
 #include "core/json_reader.h"
 #include "integrators/area_light_view.h"
 #include "integrators/camera_layers.h"
+#include "integrators/env_light.h"
 #include "integrators/surface_light.h"
 #include "integrators/tracking.h"
 #include "media/phase.h"
@@ -76,19 +77,23 @@ Rgb OctaveIntegrator::octave_scatter(int j, double bj, const Vec3& p, const Vec3
       for (int c = 0; c < 3; ++c) T[c] = std::pow(std::max(float(lights.T[l][c]), 1e-30f), bj);
       Li += lights.ls[l].weight * f * T;
     }
-    // The environment: one phase-sampled direction, marched transmittance.
-    if (ctx_.has_environment) {
-      const double u1 = rng.uniform(), u2 = rng.uniform();
-      const Vec3 wi = phase_sample(phase, d, u1, u2);
+    // The environment: marched transmittance T^(b^j); the constant one along one phase-sampled
+    // direction, the image by MIS of a map- and a phase-sampled direction (integrators/env_light.h).
+    auto env_T = [&](const Vec3& wi) {
+      constexpr double kInf = std::numeric_limits<double>::infinity();
       const Rgb T =
-          ctx_.surfaces.occluded(p, wi, std::numeric_limits<double>::infinity())
+          ctx_.surfaces.occluded(p, wi, kInf)
               ? Rgb(0.0)
-              : marched_transmittance(ctx_.media, ctx_.majorants, p, wi,
-                                      std::numeric_limits<double>::infinity(), 0.25 / std::max(bj, 0.05));
+              : marched_transmittance(ctx_.media, ctx_.majorants, p, wi, kInf, 0.25 / std::max(bj, 0.05));
       Rgb Tb;
       for (int c = 0; c < 3; ++c) Tb[c] = std::pow(std::max(T[c], 1e-300), bj);
-      Li += ctx_.environment * Tb;
+      return Tb;
+    };
+    if (ctx_.constant_environment()) {
+      const double u1 = rng.uniform(), u2 = rng.uniform();
+      Li += ctx_.environment * env_T(phase_sample(phase, d, u1, u2));
     }
+    if (ctx_.env_map) Li += medium_env_map_light(*ctx_.env_map, phase, d, rng, env_T);
     in_scatter += mp.sigma_s_i[i] * Li;
   }
   return in_scatter;
@@ -157,9 +162,9 @@ Rgb OctaveIntegrator::trace(const Ray& ray, Rng& rng, CameraSample* sample, int 
   // The surface the ray ends on (lit directly and by one gathered ray) or the environment.
   const GatherFn gather = [&](const Ray& r) { return trace(r, rng, nullptr, bounces - 1); };
   Rgb surface_direct;
-  const Rgb L_end = ray_end_radiance(ctx_, on_surface ? &hit : nullptr, exp(-tau), rng, sample,
+  const Rgb L_end = ray_end_radiance(ctx_, on_surface ? &hit : nullptr, d, exp(-tau), rng, sample,
                                      bounces > 0 ? &gather : nullptr, &surface_direct, kSurfaceShadowStep);
-  layers.finish(ctx_, on_surface ? Rgb(0.0) : exp(-tau), direct + surface_direct);
+  layers.finish(ctx_, d, on_surface ? Rgb(0.0) : exp(-tau), direct + surface_direct);
   return L + L_end;
 }
 

@@ -7,7 +7,8 @@
 // (c^j P + (1 - c^j) / (4 pi)), which scales their mean cosine by c^j. Octave 0 is `single`.
 // Light transmittance: one deep shadow map per light of exp(-tau), octave j reads T^(b^j) (exact for
 // the scaled extinction, which scales tau uniformly). The environment: one direction per octave sampled
-// from that octave's phase function, marched transmittance. A baseline, not physics: a, b, c are knobs.
+// from that octave's phase function (an image: MIS with one map-sampled direction), marched
+// transmittance. A baseline, not physics: a, b, c are knobs.
 //
 // Options (the JSON fields of the scene's integrator block besides type, spp, seed, max_events):
 //

@@ -3,6 +3,7 @@
 #include "core/json_reader.h"
 #include "integrators/area_light_view.h"
 #include "integrators/camera_layers.h"
+#include "integrators/env_light.h"
 #include "integrators/surface_light.h"
 #include "integrators/tracking.h"
 #include "scene/lights.h"
@@ -52,7 +53,7 @@ struct FirstFlight {
 // over its null collisions). A surface's own layers (record_surface_hit) were written when it was met.
 void fill_camera_sample(const SceneContext& ctx, const FirstFlight& f, const Rgb& L, CameraSample* s) {
   s->escape_transmittance = f.escaped ? f.weight : Rgb(0.0);
-  s->background = f.escaped && ctx.has_environment ? f.weight * ctx.environment : Rgb(0.0);
+  s->background = f.escaped && ctx.has_environment ? f.weight * ctx.environment_radiance(f.ray.d) : Rgb(0.0);
   s->direct = s->background + f.direct;
   if (s->depth_wanted) march_depth(ctx.media, ctx.majorants, f.ray.o, f.ray.d, kDepthTauStep, s, s->depth);
   if (!s->deep) return;
@@ -119,12 +120,24 @@ Rgb PathTracer::direct_light(const Vec3& p, const Vec3& d, int medium, int wide_
     if (f <= 0.0) continue;
     L += ls.weight * shadow_transmittance(ctx_, p, ls.wi, ls.distance, rng) * f;
   }
-  // The environment through a phase-sampled direction: f / pdf = 1.
-  if (ctx_.has_environment) {
+  // The constant environment through a phase-sampled direction: f / pdf = 1.
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  if (ctx_.constant_environment()) {
     const double u1 = rng.uniform(), u2 = rng.uniform();
     const Vec3 wi = phase_sample(phase, d, u1, u2);
-    const Rgb T = shadow_transmittance(ctx_, p, wi, std::numeric_limits<double>::infinity(), rng);
+    const Rgb T = shadow_transmittance(ctx_, p, wi, kInf, rng);
     L += ctx_.environment * T * split_weight(medium, dot(d, wi), wide_scatters);
+  }
+  // The environment image: a map-sampled and a phase-sampled direction by MIS (integrators/env_light.h).
+  if (ctx_.env_map) {
+    const double u1 = rng.uniform(), u2 = rng.uniform(), v1 = rng.uniform(), v2 = rng.uniform();
+    L += env_map_mis(
+        *ctx_.env_map, u1, u2, phase_sample(phase, d, v1, v2),
+        [&](const Vec3& wi) {
+          return Rgb(phase_eval(phase, dot(d, wi)) * split_weight(medium, dot(d, wi), wide_scatters));
+        },
+        [&](const Vec3& wi) { return phase_eval(phase, dot(d, wi)); },
+        [&](const Vec3& wi) { return shadow_transmittance(ctx_, p, wi, kInf, rng); });
   }
   return L;
 }
@@ -194,7 +207,7 @@ Rgb PathTracer::Li(const Ray& ray, Rng& rng, CameraSample* sample) const {
     } else if (escaped) {
       if (events == 0) first.end(true, beta, scatter_p);
       // Only camera rays see the environment directly; later escapes were counted by NEE.
-      if (events == 0 && ctx_.has_environment) L += beta * ctx_.environment;
+      if (events == 0 && ctx_.has_environment) L += beta * ctx_.environment_radiance(d);
       break;
     } else {
       if (events == 0) first.end(false, beta, scatter_p);

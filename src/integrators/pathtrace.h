@@ -4,7 +4,8 @@
 // (one scalar majorant for all channels, collision events chosen with channel-averaged
 // probabilities weighted by the path throughput and per-channel weights: Kutz et al. 2017's
 // history-aware spectral tracking); next-event estimation to every light
-// with ratio-tracked transmittance (the environment through a phase-sampled direction); exact
+// with ratio-tracked transmittance (a constant environment through a phase-sampled direction, an
+// environment image by MIS of a map- and a phase-sampled direction: integrators/env_light.h); exact
 // phase sampling; unbiased Russian roulette.
 //
 // Options (the JSON fields of the scene's integrator block besides type, spp, seed, max_events):

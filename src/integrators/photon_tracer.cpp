@@ -5,6 +5,7 @@
 
 #include <cmath>
 
+#include "integrators/env_light.h"
 #include "scene/area_lights.h"
 #include "scene/lights.h"
 
@@ -55,11 +56,19 @@ Photon emit(const SceneContext& ctx, size_t source, const Vec3& c, double r, dou
       // leaves area lights out, passes a stratified sample.)
       emit_area_photon(light, n, u1, u2, u3, u4, &p.x, &p.w, &p.power);
     }
-  } else {
+  } else if (!ctx.env_map) {
     // Uniform radiance L from every direction: flux L 4 pi A through a disc of area A.
     p.w = spherical_direction(1.0 - 2.0 * u1, 2.0 * kPi * u2, Vec3(0, 0, 1));
     p.x = through_disc(p.w);
     p.power = ctx.environment * (4.0 * kPi * disc_area / n);
+  } else {
+    // An environment image (with any constant part): arriving along wi with density pdf(wi), flux
+    // L(wi) A / pdf(wi) through the disc (integrators/env_light.h: env_photon_direction).
+    double pdf = 0.0;
+    const Vec3 wi = env_photon_direction(ctx, u1, u2, &pdf);
+    p.w = -wi;
+    p.x = through_disc(p.w);
+    p.power = pdf > 0.0 ? ctx.environment_radiance(wi) * (disc_area / (pdf * n)) : Rgb(0.0);
   }
   return p;
 }

@@ -17,7 +17,8 @@
 // at zero.
 //
 // The environment (uniform radiance, smooth in angle) is carried by the grid from its entry: its
-// flights deposit from order 0, so `mfs` needs no environment sampling on the camera ray.
+// flights deposit from order 0, so `mfs` needs no environment sampling on the camera ray. An environment
+// image's photons leave it by luminance (integrators/env_light.h): the grid holds its moments l <= 2.
 //
 // Deterministic: photon i uses its own random stream; photons are split into a fixed number of
 // batches (each its own grid, summed in order), so the grid does not depend on the thread count.

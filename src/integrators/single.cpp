@@ -3,6 +3,7 @@
 #include "core/json_reader.h"
 #include "integrators/area_light_view.h"
 #include "integrators/camera_layers.h"
+#include "integrators/env_light.h"
 #include "integrators/surface_light.h"
 #include "integrators/tracking.h"
 #include "media/phase.h"
@@ -11,6 +12,7 @@
 namespace nimbus {
 
 namespace {
+constexpr double kInf = std::numeric_limits<double>::infinity();
 const std::vector<std::string> kTransmittanceNames = {"ratio", "shadow_map"};
 }  // namespace
 
@@ -86,12 +88,15 @@ Rgb SingleScatter::trace(const Ray& ray, Rng& rng, CameraSample* sample, int bou
             if (f <= 0.0) continue;
             Li += ls.weight * f * light_transmittance(l, p, ls, rng);
           }
-          if (ctx_.has_environment) {
+          if (ctx_.constant_environment()) {
             const double u1 = rng.uniform(), u2 = rng.uniform();
             const Vec3 wi = phase_sample(phase, d, u1, u2);
-            Li += ctx_.environment *
-                  shadow_transmittance(ctx_, p, wi, std::numeric_limits<double>::infinity(), rng);
+            Li += ctx_.environment * shadow_transmittance(ctx_, p, wi, kInf, rng);
           }
+          if (ctx_.env_map)  // map- and phase-sampled by MIS (integrators/env_light.h)
+            Li += medium_env_map_light(*ctx_.env_map, phase, d, rng, [&](const Vec3& wi) {
+              return shadow_transmittance(ctx_, p, wi, kInf, rng);
+            });
         }
         in_scatter += mp.sigma_s_i[i] * Li / double(s_.light_samples);
       }
@@ -107,9 +112,9 @@ Rgb SingleScatter::trace(const Ray& ray, Rng& rng, CameraSample* sample, int bou
   const GatherFn gather = [&](const Ray& r) { return trace(r, rng, nullptr, bounces - 1); };
   Rgb surface_direct;
   const Rgb L_end =
-      ray_end_radiance(ctx_, on_surface ? &hit : nullptr, T, rng, sample, bounces > 0 ? &gather : nullptr,
+      ray_end_radiance(ctx_, on_surface ? &hit : nullptr, d, T, rng, sample, bounces > 0 ? &gather : nullptr,
                        &surface_direct, shadow_maps_.empty() ? 0.0 : kSurfaceShadowStep);
-  layers.finish(ctx_, on_surface ? Rgb(0.0) : T, L + surface_direct);
+  layers.finish(ctx_, d, on_surface ? Rgb(0.0) : T, L + surface_direct);
   return L + L_end;
 }
 

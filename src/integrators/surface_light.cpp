@@ -1,11 +1,24 @@
 // Light at surfaces (integrators/surface_light.h).
 #include "integrators/surface_light.h"
 
+#include "integrators/env_light.h"
 #include "integrators/shadow_map.h"
 #include "integrators/tracking.h"
 #include "scene/lights.h"
 
 namespace nimbus {
+
+namespace {
+// Set while a surface gathers its one ray (surface_radiance with a gather) in a scene with an environment
+// image: that surface took the image's light by MIS already, so the gathered ray's escape shows only the
+// constant environment. Per thread: an integrator's Li runs on one thread, the gather inside it.
+thread_local bool t_env_map_taken = false;
+struct EnvMapTakenHere {
+  bool saved;
+  explicit EnvMapTakenHere(bool taken) : saved(t_env_map_taken) { t_env_map_taken = taken; }
+  ~EnvMapTakenHere() { t_env_map_taken = saved; }
+};
+}  // namespace
 
 Rgb shadow_transmittance(const SceneContext& ctx, const Vec3& p, const Vec3& w, double tmax, Rng& rng,
                          double march_step) {
@@ -36,19 +49,44 @@ Rgb surface_radiance(const SceneContext& ctx, const SurfaceHit& hit, Rng& rng, c
   Rgb L = surface_direct_light(ctx, hit, diffuse->albedo, rng, march_step);
   if (direct_part) *direct_part = L;
   if (!gather && !ctx.has_environment) return L;
+  // The environment image by MIS (integrators/env_light.h); a gathered ray then leaves it out where it
+  // escapes (EnvMapTakenHere), so that it is counted once.
+  if (ctx.env_map) L += diffuse->albedo * surface_env_map_light(ctx, hit, rng, march_step);
+  if (!gather && !ctx.constant_environment()) return L;
   const double u1 = rng.uniform(), u2 = rng.uniform();
   const Vec3 wi = cosine_direction(hit.ns, u1, u2);
   if (dot(hit.ng, wi) <= 0.0) return L;
   const Vec3 o = SceneSurfaces::offset(hit, wi);
-  if (gather) return L + diffuse->albedo * (*gather)(Ray{o, wi});
+  if (gather) {
+    const EnvMapTakenHere taken(ctx.env_map != nullptr);
+    return L + diffuse->albedo * (*gather)(Ray{o, wi});
+  }
   return L + diffuse->albedo * ctx.environment *
                  shadow_transmittance(ctx, o, wi, std::numeric_limits<double>::infinity(), rng, march_step);
 }
 
-Rgb ray_end_radiance(const SceneContext& ctx, const SurfaceHit* hit, const Rgb& T, Rng& rng,
+Rgb surface_env_map_light(const SceneContext& ctx, const SurfaceHit& hit, Rng& rng, double march_step) {
+  const double u1 = rng.uniform(), u2 = rng.uniform(), v1 = rng.uniform(), v2 = rng.uniform();
+  // Lit on the viewer's side only (the shading and the geometric normal agree), cos / pi per unit albedo.
+  auto cosine_pdf = [&](const Vec3& wi) {
+    return dot(hit.ng, wi) > 0.0 ? std::max(0.0, dot(hit.ns, wi)) / kPi : 0.0;
+  };
+  return env_map_mis(
+      *ctx.env_map, u1, u2, cosine_direction(hit.ns, v1, v2),
+      [&](const Vec3& wi) { return Rgb(cosine_pdf(wi)); }, cosine_pdf,
+      [&](const Vec3& wi) {
+        return shadow_transmittance(ctx, SceneSurfaces::offset(hit, wi), wi,
+                                    std::numeric_limits<double>::infinity(), rng, march_step);
+      });
+}
+
+Rgb ray_end_radiance(const SceneContext& ctx, const SurfaceHit* hit, const Vec3& d, const Rgb& T, Rng& rng,
                      CameraSample* sample, const GatherFn* gather, Rgb* direct_part, double march_step) {
   if (direct_part) *direct_part = Rgb(0.0);
-  if (!hit) return ctx.has_environment ? T * ctx.environment : Rgb(0.0);
+  if (!hit) {
+    if (!ctx.has_environment) return Rgb(0.0);
+    return T * (t_env_map_taken ? ctx.environment : ctx.environment_radiance(d));
+  }
   if (sample) record_surface_hit(ctx, *hit, T, sample);
   if (max_component(T) <= 0.0) return Rgb(0.0);
   Rgb direct(0.0);

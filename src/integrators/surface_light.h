@@ -13,6 +13,10 @@ namespace nimbus {
 // midpoint error O(step^2) in smooth media, well under the noise of a few spp.
 inline constexpr double kSurfaceShadowStep = 0.1;
 
+// The environment image's light on a diffuse surface point per unit albedo (cosine-weighted irradiance
+// / pi): a map-sampled and a cosine-sampled direction by MIS (integrators/env_light.h). ctx.env_map set.
+Rgb surface_env_map_light(const SceneContext& ctx, const SurfaceHit& hit, Rng& rng, double march_step = 0.0);
+
 // Transmittance from p along w (unit) over (0, tmax): 0 when a surface blocks the way, else the media's
 // by ratio tracking (unbiased; march_step 0) or by a deterministic midpoint march with steps of
 // march_step optical depth (smooth shadows for the integrators that march: octave, mfs).
@@ -30,18 +34,19 @@ Rgb surface_direct_light(const SceneContext& ctx, const SurfaceHit& hit, const R
 // albedo times the radiance arriving along one cosine-sampled direction (weight albedo: (albedo / pi)
 // cos / (cos / pi)). `gather(ray)` is that radiance as the integrator itself computes it along a ray (the
 // medium's scattered light, the environment and surfaces behind, with their direct light); without a
-// gather (nullptr), only the environment through the media is gathered.
+// gather (nullptr), only the environment through the media is gathered. An environment image is taken by
+// surface_env_map_light (MIS) in both cases, and the gathered ray's own escape then leaves it out.
 using GatherFn = std::function<Rgb(const Ray&)>;
 // *direct_part (when given) receives the lights' direct part of the result.
 Rgb surface_radiance(const SceneContext& ctx, const SurfaceHit& hit, Rng& rng, const GatherFn* gather,
                      Rgb* direct_part = nullptr, double march_step = 0.0);
 
-// The light at the end of a marched ray, seen through its transmittance T: the surface it ends on (hit,
-// through surface_radiance with `gather`; its layers recorded into a non-null sample, with a deep
-// segment for a diffuse surface), or with hit == nullptr the environment. *direct_part (when given)
+// The light at the end of a marched ray (direction d), seen through its transmittance T: the surface it
+// ends on (hit, through surface_radiance with `gather`; its layers recorded into a non-null sample, with a
+// deep segment for a diffuse surface), or with hit == nullptr the environment along d. *direct_part (when given)
 // receives the surface's direct light as seen through T (0 for the environment).
 // march_step: as for shadow_transmittance.
-Rgb ray_end_radiance(const SceneContext& ctx, const SurfaceHit* hit, const Rgb& T, Rng& rng,
+Rgb ray_end_radiance(const SceneContext& ctx, const SurfaceHit* hit, const Vec3& d, const Rgb& T, Rng& rng,
                      CameraSample* sample, const GatherFn* gather, Rgb* direct_part = nullptr,
                      double march_step = 0.0);
 

@@ -8,6 +8,7 @@
 
 #include "core/json_reader.h"
 #include "integrators/registry.h"
+#include "io/scene_environment.h"
 #include "io/scene_fields.h"
 #include "io/scene_lights.h"
 #include "io/scene_surfaces.h"
@@ -170,8 +171,11 @@ Scene parse_scene(const nlohmann::json& doc, const std::string& name, const std:
   if (root.has("surfaces"))
     for (JsonObject& s : root.array_of_objects("surfaces", true))
       scene.surfaces.push_back(parse_surface(s, base_dir));
-  for (JsonObject& l : root.array_of_objects("lights", true))
+  for (JsonObject& l : root.array_of_objects("lights", true)) {
     scene.lights.push_back(parse_light(l, base_dir));
+    if (count_environment_images(scene.lights) > 1)
+      l.fail("file", "a scene takes at most one environment image");
+  }
   if (root.has("integrator"))
     scene.integrator = parse_integrator(doc["integrator"], root.object("integrator"));
   if (root.has("film")) scene.film = parse_film(root.object("film"));

@@ -4,12 +4,12 @@
 #include <fmt/format.h>
 
 #include "io/scene_area_lights.h"
+#include "io/scene_environment.h"
 #include "io/scene_fields.h"
 
 namespace nimbus {
 
 Light parse_light(JsonObject o, const std::filesystem::path& base_dir) {
-  (void)base_dir;  // no light reads a file yet
   const std::string type = o.string("type");
   Light light;
   if (type == "directional") {
@@ -24,9 +24,7 @@ Light parse_light(JsonObject o, const std::filesystem::path& base_dir) {
     p.intensity = o.rgb("intensity", 0.0);
     light = p;
   } else if (type == "environment") {
-    EnvironmentLight e;
-    e.radiance = o.rgb("radiance", 0.0);
-    light = e;
+    light = parse_environment_light(o, base_dir);  // io/scene_environment.cpp
   } else if (type == "spot") {
     light = parse_spot_light(o);
   } else if (type == "sphere") {

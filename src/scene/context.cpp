@@ -11,6 +11,7 @@ SceneContext::SceneContext(const Scene& scene, int majorant_resolution, bool glo
     if (const auto* env = std::get_if<EnvironmentLight>(&l)) {
       environment += env->radiance;
       has_environment = true;
+      if (env->map) env_map = env->map;  // the parser allows one image per scene
     } else {
       lights.push_back(l);
     }

@@ -30,7 +30,11 @@ Mapping (docs/validation/cycles.md explains and checks each line):
   point        POINT lamp, radius 0, Power P = 4 pi I (Cycles: I = P / (4 pi) W/sr, eval_fac = 1/(4 pi)).
   spot, sphere, rectangle: see build_area_or_spot_light (sphere: build_sphere_light_mesh by default,
                --sphere-lights lamp for a POINT lamp of radius r).
-  environment  World Background, Color = radiance, Strength 1 (black world without one).
+  environment  World Background, Color = radiance, Strength 1 (black world without one). An image
+               (`file`): Environment Texture node, EQUIRECTANGULAR, interpolation Closest (nimbus
+               reads the nearest pixel), colour space Linear, Strength = intensity; its `transform`
+               rotation R (world = R map) through a Mapping node (POINT) rotating the lookup
+               direction by R^-1 (Generated coordinates of the world = the ray direction).
   integrator   max_events 0 -> volume bounces 1024; max_events k -> volume bounces k - 1.
 """
 import argparse
@@ -341,7 +345,28 @@ def build_media(media, segments):
 
 
 # --- Lights -----------------------------------------------------------------------------------
-def build_lights(lights, sphere_lights="mesh", segments=256):
+def environment_image(world, bg, light, scene_dir):
+    """An environment image light: Texture Coordinate (Generated) -> Mapping (R^-1) -> Environment
+    Texture -> Background, Strength = intensity."""
+    nodes, links = world.node_tree.nodes, world.node_tree.links
+    path = Path(light["file"])
+    path = path if path.is_absolute() else scene_dir / path
+    tex = nodes.new("ShaderNodeTexEnvironment")
+    tex.image = bpy.data.images.load(str(path))
+    tex.image.colorspace_settings.name = "Linear"
+    tex.interpolation = "Closest"
+    tex.projection = "EQUIRECTANGULAR"
+    coords = nodes.new("ShaderNodeTexCoord")
+    mapping = nodes.new("ShaderNodeMapping")
+    mapping.vector_type = "POINT"
+    mapping.inputs["Rotation"].default_value = transform_matrix(light.get("transform")).to_3x3().inverted().to_euler("XYZ")
+    links.new(coords.outputs["Generated"], mapping.inputs["Vector"])
+    links.new(mapping.outputs["Vector"], tex.inputs["Vector"])
+    links.new(tex.outputs["Color"], bg.inputs["Color"])
+    bg.inputs["Strength"].default_value = float(light.get("intensity", 1.0))
+
+
+def build_lights(lights, scene_dir, sphere_lights="mesh", segments=256):
     scene = bpy.context.scene
     world = bpy.data.worlds.new("world")
     world.use_nodes = True
@@ -368,6 +393,8 @@ def build_lights(lights, sphere_lights="mesh", segments=256):
             data.shadow_soft_size = 0.0
             obj = link(bpy.data.objects.new(f"point{i}", data))
             obj.location = Vector(light["position"])
+        elif kind == "environment" and "file" in light:
+            environment_image(world, bg, light, scene_dir)
         elif kind == "sphere" and sphere_lights == "mesh":
             build_sphere_light_mesh(i, light, segments)
         elif kind in ("spot", "sphere", "rectangle"):
@@ -568,7 +595,8 @@ def main():
     mesh_info = build_media(scene_json.get("media", []), args.sphere_segments)
     mesh_info += build_surfaces(scene_json.get("surfaces", []), args.sphere_segments,
                                 Path(args.scene).resolve().parent)
-    build_lights(scene_json.get("lights", []), args.sphere_lights, args.sphere_segments)
+    build_lights(scene_json.get("lights", []), Path(args.scene).resolve().parent, args.sphere_lights,
+                 args.sphere_segments)
     configure(args, scene_json.get("integrator", {}))
     print("scene_to_blender:", json.dumps({"camera": cam_info, "media": mesh_info,
                                            "samples": bpy.context.scene.cycles.samples,
