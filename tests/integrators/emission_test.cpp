@@ -168,6 +168,38 @@ TEST(Emission, BlackbodyFromTemperatureGrid) {
   }
 }
 
+// The procedural fire of data/volumes/ draws density, temperature (another voxel size) and a vec3
+// colour grid from one OpenVDB file: the tint is the colour grid (in [0, 1]), the core emits, and the
+// medium's bounds hold every grid.
+TEST(Emission, FireFileDrawsSeveralGrids) {
+  const auto file = std::filesystem::path(NIMBUS_SOURCE_DIR) / "data/volumes/fire.vdb";
+  if (!std::filesystem::exists(file)) GTEST_SKIP();
+  const Scene scene = scene_from_json("{" + test::camera_json() + R"(, "lights": [], "media": [
+      {"shape": {"type": "vdb", "file": ")" +
+                                      file.string() + R"(", "grid": "density"}, "sigma_s": 10,
+       "sigma_a": 2, "temperature_grid": "temperature", "temperature_scale": 1800, "color_grid": "color"}]})");
+  const Medium& m = scene.media[0];
+  ASSERT_TRUE(m.emission.grids && m.emission.grids->temperature && m.emission.grids->color[2]);
+  const SceneMedia media(scene.media);
+  EXPECT_TRUE(media.emits());
+  const Bounds t = m.emission.grids->temperature->world_bounds();
+  EXPECT_TRUE(media.bounds(0).contains(t.lo) && media.bounds(0).contains(t.hi));
+  MediumPoint mp;
+  double hottest = 0.0;
+  for (int k = 0; k < 2000; ++k) {
+    const Vec3 p(0.6 * std::sin(k * 1.7), 0.6 * std::cos(k * 2.3), 3.0 * (k + 0.5) / 2000.0);
+    media.eval(p, &mp);
+    const double d = media.density(0, p);
+    hottest = std::max(hottest, mp.emission.x);
+    if (d <= 0.0) continue;
+    const DensityGrid& r = *m.emission.grids->color[0];
+    const double tint = std::clamp(r.density_index(r.world_to_index(p)), 0.0, 1.0);
+    EXPECT_NEAR(mp.sigma_s.x, 10.0 * d * tint, 1e-9 * (1.0 + mp.sigma_s.x));
+    EXPECT_LE(mp.sigma_s.z, 10.0 * d + 1e-12);
+  }
+  EXPECT_GT(hottest, 0.0);
+}
+
 std::string load_error(const std::string& text) {
   try {
     scene_from_json(text);
