@@ -168,6 +168,25 @@ TEST(Emission, BlackbodyFromTemperatureGrid) {
   }
 }
 
+// An emission grid scales the constant emission in place of the density, and may reach beyond the
+// density grid: here a grid of 1 (voxel 0.05, 40 voxels across) with no extinction at all, so L = j times
+// the grid's integral along the ray, 2 x 40 x 0.05 = 4 (39 voxel spans plus two half-voxel ramps).
+TEST(Emission, EmissionGridBeyondTheDensity) {
+  test::ScratchDir dir("emission_grid");
+  write_fire(dir / "fire.nvdb", 1.0f);
+  const Scene scene = scene_from_json("{" + test::camera_json() + R"(, "lights": [], "media": [
+      {"shape": {"type": "vdb", "file": ")" +
+                                      (dir / "fire.nvdb").string() + R"(", "grid": "density"},
+       "sigma_s": 0, "emission": 2, "emission_grid": "temperature"}]})");
+  const SceneContext ctx(scene);
+  const Vec3 o(0.01, -4, 0.02), d(0, 1, 0);
+  const auto pt = estimate(*make(ctx, "pathtrace"), o, d, 4000);
+  EXPECT_NEAR(pt.c[0].mean, 4.0, 5.0 * pt.c[0].stderr_mean() + 1e-12);
+  EXPECT_LT(pt.c[0].stderr_mean(), 0.02 * 4.0);
+  for (const char* type : {"single", "octave", "mfs"})
+    EXPECT_NEAR(estimate(*make(ctx, type), o, d, 4).c[0].mean, 4.0, 2e-3 * 4.0) << type;
+}
+
 // The procedural fire of data/volumes/ draws density, temperature (another voxel size) and a vec3
 // colour grid from one OpenVDB file: the tint is the colour grid (in [0, 1]), the core emits, and the
 // medium's bounds hold every grid.
