@@ -19,6 +19,7 @@ namespace nimbus {
 class DensityGrid;
 class EnvMap;
 class TriangleMesh;
+struct EmissionGrids;
 
 // Pinhole camera. fov_y_deg is the full vertical field of view; image row 0 is the top;
 // camera right = forward x up.
@@ -56,12 +57,23 @@ struct CloudShape {
 };
 using Shape = std::variant<SphereShape, BoxShape, VdbShape, CloudShape>;
 
+// A medium's emission and its further grids (docs/scene-format.md, "Emission"; media/emission.h). The
+// emitted radiance per unit length is radiance x (the emission grid, or else the shape's density) plus,
+// with a temperature grid, intensity x sigma_a x the black-body RGB of scale x grid + offset (kelvin).
+struct MediumEmission {
+  Rgb radiance{0.0};                                        // `emission`, >= 0
+  std::string emission_grid, temperature_grid, color_grid;  // grids of the vdb shape's file ("": none)
+  double temperature_scale = 1.0, temperature_offset = 0.0, intensity = 1.0;
+  std::shared_ptr<const EmissionGrids> grids;  // loaded by load_scene
+};
+
 struct Medium {
   Shape shape;
   Transform transform;   // world = transform(the shape's own placement); identity by default
   Rgb sigma_s{1, 1, 1};  // 1/length
   Rgb sigma_a{0, 0, 0};  // 1/length
   Phase phase = IsotropicPhase{};
+  MediumEmission emission;  // none by default
 };
 
 // `direction` is the way the light travels; `irradiance` on a surface facing it. A non-zero

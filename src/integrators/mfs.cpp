@@ -117,7 +117,8 @@ MfsIntegrator::MfsIntegrator(const SceneContext& context, MfsSettings settings, 
                                        *s_.scatter_grid_resolution, seed);
   }
   // Wide scatters 2 .. K from the scatter grid (for K = 1 only the environment's light).
-  if (s_.large_angle_scatters != 0 && (s_.large_angle_scatters != 1 || ctx_.has_environment)) {
+  if (s_.large_angle_scatters != 0 &&
+      (s_.large_angle_scatters != 1 || ctx_.has_environment || ctx_.media.emits())) {
     ScatterGridSettings grid;
     grid.photons = s_.photons;
     grid.resolution = *s_.scatter_grid_resolution;
@@ -184,6 +185,12 @@ Rgb MfsIntegrator::trace(const Ray& ray, Rng& rng, CameraSample* sample, int bou
         // Advance the camera-side state over the whole step.
         const Rgb T0 = s_.light_side() ? cam.T_full : cam.T_red;
         cam.advance(k, t, dt, jitter);
+        if (ctx_.media
+                .emits()) {  // emission along the ray, through the same transmittance as the grid's light
+          const Rgb E = emission_over_step(mp.emission, T0, s_.light_side() ? cam.T_full : cam.T_red, dt);
+          L += E;
+          L_step += E;
+        }
         layers.step(t - jitter * dt, dt, T0, s_.light_side() ? cam.T_full : cam.T_red, mp, L_step);
         return max_component(s_.light_side() ? cam.T_full : cam.T_red) > 1e-6;
       });

@@ -128,7 +128,11 @@ Rgb OctaveIntegrator::trace(const Ray& ray, Rng& rng, CameraSample* sample, int 
   lights.ok.resize(ctx_.lights.size());
   march(ctx_.majorants, o, d, hit.t, s_.tau_step, jitter, [&](const Vec3& p, double t, double dt) {
     ctx_.media.eval(p, &mp);
-    Rgb L_step(0.0);
+    // Emission, seen through the true transmittance (octaves do not scatter it).
+    Rgb L_step = ctx_.media.emits()
+                     ? emission_over_step(mp.emission, exp(-tau), exp(-tau - mp.sigma_t() * dt), dt)
+                     : Rgb(0.0);
+    L += L_step;
     if (max_component(mp.sigma_s) > 0.0) {
       const Rgb tau_here = tau + mp.sigma_t() * (jitter * dt);
       // Light transmittance exp(-tau_l) once per light (octave j: raised to b^j).

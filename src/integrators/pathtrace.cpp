@@ -188,6 +188,8 @@ Rgb PathTracer::Li(const Ray& ray, Rng& rng, CameraSample* sample) const {
     Vec3 scatter_p;
     const bool escaped = track(ctx_.majorants, o, d, hit.t, rng, [&](const Vec3& p, double maj) {
       ctx_.media.eval(p, &mp);
+      // Emission at every tentative collision, j / majorant: an unbiased estimate of int T j dt.
+      if (ctx_.media.emits()) L += beta * mp.emission / maj;
       if (!collide(mp, maj, beta, rng, &scatter_medium)) return first.null_collision(events, p);
       scatter_p = p;
       return false;

@@ -10,6 +10,7 @@
 #include "core/sh.h"
 #include "integrators/photon_tracer.h"
 #include "integrators/shadow_map.h"
+#include "media/emission_sampler.h"
 
 namespace nimbus {
 namespace {
@@ -77,6 +78,19 @@ std::vector<float> tent_downsample(const NodeGrid& fine, const float* src, const
   return values;
 }
 
+// A photon emitted by the media: a point drawn by the emission sampler, an isotropic direction, power
+// 4 pi j(x) / (pdf(x) n) (emitted power per unit volume 4 pi j; an unbiased estimate of the whole).
+Photon emit_from_media(const EmissionSampler& sampler, const SceneMedia& media, double n, Rng& rng) {
+  const double u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform(), u3 = rng.uniform();
+  const double v1 = rng.uniform(), v2 = rng.uniform();
+  double pdf = 0.0;
+  Photon p;
+  p.x = sampler.sample(u0, u1, u2, u3, &pdf);
+  p.w = spherical_direction(1.0 - 2.0 * v1, 2.0 * kPi * v2, Vec3(0, 0, 1));
+  p.power = pdf > 0.0 ? media.emission(p.x) * (4.0 * kPi / (pdf * n)) : Rgb(0.0);
+  return p;
+}
+
 // The photons of one scatter grid: which source and channel photon j belongs to, what its flights
 // deposit and what its real collisions do.
 struct ScatterPhotons {
@@ -87,9 +101,10 @@ struct ScatterPhotons {
   const NodeGrid& grid;
   int bands;
   bool grey;      // one pass carrying RGB power (else one pass per channel)
-  size_t lights;  // light sources (then the environment, if any)
+  size_t lights;  // light sources (then the environment, then the media's emission, if any)
   size_t sources, per_source;
-  Vec3 centre;  // of the media's bounding sphere, which the photons are aimed at
+  const EmissionSampler* emission;  // null when no medium emits
+  Vec3 centre;                      // of the media's bounding sphere, which the photons are aimed at
   double radius;
   int K;  // flights after wide scatter 1 .. K - 1 are kept
 
@@ -104,9 +119,12 @@ void ScatterPhotons::trace(size_t j, Rng& rng, PhotonBatch& batch) const {
   size_t source = (j / per_source) % sources;
   if (source >= lights) source = ctx.lights.size();  // the environment
   // The environment's light is smooth in angle: the grid carries it from its entry (order 0).
-  const int first_order = source < ctx.lights.size() ? 1 : 0;
+  // So is the media's emission (isotropic, the last source): the grid carries it from its first flight.
+  const bool from_media = emission && (j / per_source) % sources == sources - 1;
+  const int first_order = source < ctx.lights.size() && !from_media ? 1 : 0;
   const int c = pass;  // the channel whose coefficients drive this photon
-  const Photon ph = emit(ctx, source, centre, radius, double(per_source), rng);
+  const Photon ph = from_media ? emit_from_media(*emission, ctx.media, double(per_source), rng)
+                               : emit(ctx, source, centre, radius, double(per_source), rng);
   Rgb power = ph.power;
   if (!grey)
     for (int k = 0; k < 3; ++k)
@@ -202,7 +220,7 @@ ScatterGrid::ScatterGrid(const SceneContext& ctx, const std::vector<const PhaseS
   grid_ = node_grid_padded(media_bounds, s.resolution > 0 ? s.resolution : 32);
   values_.assign(grid_.size() * 3 * coeffs_, 0.0f);
   // With K = 1 only the environment's unscattered-by-wide light is needed (see the header).
-  if (s.max_wide_scatters == 1 && !ctx.has_environment) return;
+  if (s.max_wide_scatters == 1 && !ctx.has_environment && !ctx.media.emits()) return;
   trace(ctx, splits, peak_fraction, s);
 }
 
@@ -213,7 +231,13 @@ void ScatterGrid::trace(const SceneContext& ctx, const std::vector<const PhaseSp
   const bool grey = grey_media(ctx);
   const int passes = grey ? 1 : 3;
   const size_t lights = s.max_wide_scatters == 1 ? 0 : ctx.lights.size();  // K = 1: environment only
-  const size_t sources = lights + (ctx.has_environment ? 1 : 0);
+  // The media's emission is one more source, with its share of the photons (emit_from_media).
+  // (Only where a medium scatters does the grid's light reach the camera.)
+  bool scatters = false;
+  for (int i = 0; i < ctx.media.count(); ++i)
+    scatters = scatters || max_component(ctx.media.medium(i).sigma_s) > 0.0;
+  const EmissionSampler emission = scatters ? EmissionSampler(ctx.media) : EmissionSampler();
+  const size_t sources = lights + (ctx.has_environment ? 1 : 0) + (emission.active() ? 1 : 0);
   if (sources == 0 || s.photons <= 0) return;
   const size_t per_source = std::max<size_t>(1, size_t(s.photons) / sources);
   const size_t total = size_t(passes) * sources * per_source;
@@ -231,6 +255,7 @@ void ScatterGrid::trace(const SceneContext& ctx, const std::vector<const PhaseSp
       .lights = lights,
       .sources = sources,
       .per_source = per_source,
+      .emission = emission.active() ? &emission : nullptr,
       .centre = (media_bounds.lo + media_bounds.hi) * 0.5,
       .radius = 0.5 * extent.length() * (1.0 + 1e-9) + 1e-12,
       .K = s.max_wide_scatters <= 0 ? kMaxWideScatters : std::min(s.max_wide_scatters, kMaxWideScatters)};

@@ -70,7 +70,7 @@ Rgb SingleScatter::trace(const Ray& ray, Rng& rng, CameraSample* sample, int bou
   march(ctx_.majorants, o, d, hit.t, s_.tau_step, jitter, [&](const Vec3& p, double t, double dt) {
     ctx_.media.eval(p, &mp);
     const Rgb step_T = exp(-mp.sigma_t() * dt);
-    Rgb L_step(0.0);
+    Rgb L_step = ctx_.media.emits() ? emission_over_step(mp.emission, T, T * step_T, dt) : Rgb(0.0);
     if (max_component(mp.sigma_s) > 0.0) {
       // Camera-side transmittance to the sample point, then single scattering towards the lights.
       const Rgb T_here = T * exp(-mp.sigma_t() * (jitter * dt));
@@ -100,9 +100,9 @@ Rgb SingleScatter::trace(const Ray& ray, Rng& rng, CameraSample* sample, int bou
         }
         in_scatter += mp.sigma_s_i[i] * Li / double(s_.light_samples);
       }
-      L_step = T_here * in_scatter * dt;
-      L += L_step;
+      L_step += T_here * in_scatter * dt;
     }
+    L += L_step;
     layers.step(t - jitter * dt, dt, T, T * step_T, mp, L_step);
     T *= step_T;
     return max_component(T) > 1e-6;

@@ -8,6 +8,7 @@
 
 #include "core/json_reader.h"
 #include "integrators/registry.h"
+#include "io/scene_emission.h"
 #include "io/scene_environment.h"
 #include "io/scene_fields.h"
 #include "io/scene_lights.h"
@@ -94,6 +95,7 @@ Medium parse_medium(JsonObject o, const std::filesystem::path& base_dir) {
   m.sigma_s = o.rgb("sigma_s", 0.0);
   m.sigma_a = o.rgb("sigma_a", 0.0, Rgb(0.0));
   m.phase = o.has("phase") ? parse_phase(o.object("phase")) : Phase{IsotropicPhase{}};
+  parse_medium_emission(o, m, base_dir);  // io/scene_emission.cpp
   o.finish();
   return m;
 }

@@ -446,6 +446,18 @@ DensityGrid load_density_grid(const fs::path& file, const std::string& grid_name
   return DensityGrid::from_nanovdb(std::move(handle), file.string(), read_seconds, check_seconds);
 }
 
+std::array<DensityGrid, 3> load_vec3_grid(const fs::path& file, const std::string& grid_name) {
+  if (detect_kind(file) != FileKind::OpenVDB)
+    fail(file, fmt::format("grid \"{}\": vec3 grids are read from OpenVDB (.vdb) files only", grid_name));
+  auto handles = detail::load_openvdb_vec3_grid(file, grid_name);
+  auto component = [&](int c) {
+    check_grid_structure(file, handles[c]);
+    return DensityGrid::from_nanovdb(std::move(handles[c]),
+                                     fmt::format("{} ({}.{})", file.string(), grid_name, "xyz"[c]));
+  };
+  return {component(0), component(1), component(2)};
+}
+
 // ---- inspect --------------------------------------------------------------------------------------
 
 namespace {

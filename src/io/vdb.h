@@ -23,6 +23,11 @@ namespace nimbus {
 // does (empty grid, bbox size, NaN/inf).
 DensityGrid load_density_grid(const std::filesystem::path& file, const std::string& grid_name = "");
 
+// The vec3 grid `grid_name` of an OpenVDB (.vdb) file as three float grids (its x, y, z components), each
+// checked as load_density_grid checks a float grid. A .nvdb file is an error (vec3 grids are read from
+// OpenVDB files only).
+std::array<DensityGrid, 3> load_vec3_grid(const std::filesystem::path& file, const std::string& grid_name);
+
 // One grid of a volume file, as `nimbus info` shows it (read without converting non-float grids).
 struct GridInfo {
   std::string name;        // "" when unnamed

@@ -5,6 +5,7 @@
 #include <nanovdb/util/GridHandle.h>
 #include <nanovdb/util/HostBuffer.h>
 
+#include <array>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -21,6 +22,10 @@ using NanoHandle = nanovdb::GridHandle<nanovdb::HostBuffer>;
 // Reads the float grid `grid_name` ("" = the first float grid) of an OpenVDB file and converts it to
 // NanoVDB. Errors name the file; OpenVDB exceptions are rethrown as nimbus::Error.
 NanoHandle load_openvdb_float_grid(const std::filesystem::path& file, const std::string& grid_name);
+
+// The components of the vec3 grid `grid_name` of an OpenVDB file as three float grids (x, y, z).
+std::array<NanoHandle, 3> load_openvdb_vec3_grid(const std::filesystem::path& file,
+                                                 const std::string& grid_name);
 
 // Every grid of an OpenVDB file, for `nimbus info`.
 std::vector<GridInfo> inspect_openvdb_file(const std::filesystem::path& file);

@@ -191,6 +191,45 @@ NanoHandle load_openvdb_float_grid(const std::filesystem::path& path, const std:
   });
 }
 
+std::array<NanoHandle, 3> load_openvdb_vec3_grid(const std::filesystem::path& path,
+                                                 const std::string& grid_name) {
+  return with_grids(path, [&](const openvdb::GridPtrVec& grids) {
+    openvdb::Vec3SGrid::ConstPtr grid;
+    for (const auto& g : grids)
+      if (g->getName() == grid_name) grid = openvdb::gridConstPtrCast<openvdb::Vec3SGrid>(g);
+    if (!grid) {
+      for (const auto& g : grids)
+        if (g->getName() == grid_name)
+          fail(path,
+               fmt::format("grid {} is of type {}, not vec3s", display_name(grid_name), g->valueType()));
+      fail(path, fmt::format("no grid named \"{}\"; the file holds {}", grid_name, grid_list(grids)));
+    }
+    if (!grid->transform().isLinear())
+      fail(path, fmt::format("grid {} has a non-linear (frustum) transform, which is not supported",
+                             display_name(grid_name)));
+    if (grid->tree().activeVoxelCount() == 0)
+      fail(path, fmt::format("grid {} is empty: no active voxels", display_name(grid_name)));
+    check_index_range(path, *grid);
+    // One float grid per component, with the vec3 grid's transform and active values (tiles filled).
+    std::array<NanoHandle, 3> out;
+    for (int c = 0; c < 3; ++c) {
+      auto f = openvdb::FloatGrid::create(0.0f);
+      f->setTransform(grid->transform().copy());
+      f->setName(grid_name + "." + "xyz"[c]);
+      auto acc = f->getAccessor();
+      for (auto it = grid->cbeginValueOn(); it; ++it) {
+        if (it.isVoxelValue())
+          acc.setValue(it.getCoord(), (*it)[c]);
+        else
+          f->tree().fill(it.getBoundingBox(), (*it)[c], true);
+      }
+      out[c] = nanovdb::openToNanoVDB<nanovdb::HostBuffer>(*f, nanovdb::StatsMode::BBox,
+                                                           nanovdb::ChecksumMode::Disable);
+    }
+    return out;
+  });
+}
+
 std::vector<GridInfo> inspect_openvdb_file(const std::filesystem::path& path) {
   return with_grids(path, [&](const openvdb::GridPtrVec& grids) {
     std::vector<GridInfo> out;

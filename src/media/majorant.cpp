@@ -66,6 +66,7 @@ MajorantGrid::MajorantGrid(const SceneMedia& media, int resolution, bool global)
   }
   for (int a = 0; a < 3; ++a) cell_size_[a] = extent[a] / res_[a];
   maj_.assign(size_t(res_[0]) * res_[1] * res_[2], 0.0f);
+  const double min_cell = std::min({cell_size_.x, cell_size_.y, cell_size_.z});
   tbb::parallel_for(0, res_[2], [&](int z) {
     for (int y = 0; y < res_[1]; ++y) {
       for (int x = 0; x < res_[0]; ++x) {
@@ -78,6 +79,10 @@ MajorantGrid::MajorantGrid(const SceneMedia& media, int resolution, bool global)
           const double d = media.max_density(i, cell);
           if (d > 0.0) m += d * max_component(med.sigma_s + med.sigma_a);
         }
+        // Emitting cells get at least kEmissionCollisionsPerCell tentative collisions per cell width, so
+        // that thin or transparent emitters are sampled (media/emission.h).
+        for (int i = 0; i < media.count() && media.emits(); ++i)
+          if (media.may_emit(i, cell)) m = std::max(m, kEmissionCollisionsPerCell / min_cell);
         // Round up so the float never falls below the double bound.
         maj_[(size_t(z) * res_[1] + y) * res_[0] + x] = m > 0.0 ? std::nextafter(float(m), INFINITY) : 0.0f;
       }

@@ -12,6 +12,10 @@
 
 namespace nimbus {
 
+// The least majorant (per cell width) of a cell where a medium may emit: the tracking kernels then
+// visit every emitting cell, however thin its extinction (emission is gathered at tentative collisions).
+inline constexpr double kEmissionCollisionsPerCell = 2.0;
+
 class MajorantGrid {
  public:
   // resolution: cells along the longest axis (0 = chosen from the media: ~4 voxels per cell for

@@ -41,10 +41,16 @@ Bounds world_bounds(const Medium& m) {
   if (const auto* x = std::get_if<BoxShape>(&m.shape)) return transform_bounds(t, Bounds{x->min, x->max});
   const DensityGrid& g = *grid_of(m.shape);
   const auto* v = std::get_if<VdbShape>(&m.shape);
-  return bounds_of_mapped_box(g.index_lo(), g.index_hi(), [&](const Vec3& i) {
-    const Vec3 local = v ? g.index_to_world(i) * v->scale + v->translate : g.index_to_world(i);
+  auto to_world = [&](const Vec3& grid_world) {
+    const Vec3 local = v ? grid_world * v->scale + v->translate : grid_world;
     return t.is_identity() ? local : t.point(local);
-  });
+  };
+  Bounds b = bounds_of_mapped_box(g.index_lo(), g.index_hi(),
+                                  [&](const Vec3& i) { return to_world(g.index_to_world(i)); });
+  // The emission, temperature and colour grids may reach beyond the density grid.
+  if (const Bounds e = MediumEmissionField(m).grid_bounds(); !e.empty())
+    b.extend(bounds_of_mapped_box(e.lo, e.hi, to_world));
+  return b;
 }
 
 }  // namespace
@@ -56,7 +62,30 @@ SceneMedia::SceneMedia(const std::vector<Medium>& media) : media_(media) {
     medium_bounds_.push_back(world_bounds(m));
     bounds_.extend(medium_bounds_.back());
     to_local_.push_back(m.transform.inverse());
+    fields_.emplace_back(m);
+    emits_ = emits_ || fields_.back().emits();
+    tints_ = tints_ || fields_.back().tints();
   }
+}
+
+Vec3 SceneMedia::grid_world(int i, const Vec3& p) const {
+  const Vec3 q = to_local_[i].is_identity() ? p : to_local_[i].point(p);
+  const auto* v = std::get_if<VdbShape>(&media_[i].shape);
+  return v ? vdb_grid_world(*v, q) : q;
+}
+
+bool SceneMedia::may_emit(int i, const Bounds& box) const {
+  if (!fields_[i].emits() || !medium_bounds_[i].overlaps(box)) return false;
+  const Bounds gw = bounds_of_mapped_box(box.lo, box.hi, [&](const Vec3& p) { return grid_world(i, p); });
+  return fields_[i].may_emit(gw, max_density(i, box));
+}
+
+Rgb SceneMedia::emission(const Vec3& p) const {
+  Rgb j(0.0);
+  for (int i = 0; i < count(); ++i)
+    if (fields_[i].emits() && medium_bounds_[i].contains(p))
+      j += fields_[i].emission(grid_world(i, p), density(i, p));
+  return j;
 }
 
 double SceneMedia::density(int i, const Vec3& p) const {
@@ -107,9 +136,15 @@ void SceneMedia::eval(const Vec3& p, MediumPoint* out) const {
   out->count = count();
   out->sigma_s = Rgb(0.0);
   out->sigma_a = Rgb(0.0);
+  out->emission = Rgb(0.0);
   for (int i = 0; i < count(); ++i) {
     const double d = density(i, p);
     out->sigma_s_i[i] = media_[i].sigma_s * d;
+    if ((emits_ || tints_) && (fields_[i].emits() || fields_[i].tints()) && medium_bounds_[i].contains(p)) {
+      const Vec3 gw = grid_world(i, p);
+      if (d > 0.0 && fields_[i].tints()) out->sigma_s_i[i] *= fields_[i].tint(gw);
+      out->emission += fields_[i].emission(gw, d);
+    }
     out->sigma_s += out->sigma_s_i[i];
     out->sigma_a += media_[i].sigma_a * d;
   }
@@ -119,7 +154,11 @@ Rgb SceneMedia::sigma_t(const Vec3& p) const {
   Rgb s(0.0);
   for (int i = 0; i < count(); ++i) {
     const double d = density(i, p);
-    if (d != 0.0) s += (media_[i].sigma_s + media_[i].sigma_a) * d;
+    if (d == 0.0) continue;
+    s += (tints_ && fields_[i].tints() ? media_[i].sigma_s * fields_[i].tint(grid_world(i, p))
+                                       : media_[i].sigma_s) *
+             d +
+         media_[i].sigma_a * d;
   }
   return s;
 }

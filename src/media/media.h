@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "core/math.h"
+#include "media/emission.h"
 #include "nimbus/scene.h"
 
 namespace nimbus {
@@ -17,6 +18,7 @@ struct MediumPoint {
   int count = 0;
   std::array<Rgb, kMaxMedia> sigma_s_i{};  // scattering of each medium at the point
   Rgb sigma_s{0.0}, sigma_a{0.0};          // totals
+  Rgb emission{0.0};                       // emitted radiance per unit length, all media (media/emission.h)
   Rgb sigma_t() const { return sigma_s + sigma_a; }
 };
 
@@ -39,12 +41,21 @@ class SceneMedia {
   void eval(const Vec3& p, MediumPoint* out) const;
   // Total extinction per channel at p.
   Rgb sigma_t(const Vec3& p) const;
+  // Emission (media/emission.h): whether any medium emits, whether medium i may emit anywhere in the world
+  // box (conservative), and the emitted radiance per unit length of all media at p.
+  bool emits() const { return emits_; }
+  bool may_emit(int i, const Bounds& box) const;
+  Rgb emission(const Vec3& p) const;
 
  private:
   std::vector<Medium> media_;
   std::vector<Bounds> medium_bounds_;
   std::vector<Transform> to_local_;  // world -> the shape's space (the inverse of each medium's transform)
   Bounds bounds_;
+  std::vector<MediumEmissionField> fields_;  // emission and colour tint per medium
+  bool emits_ = false, tints_ = false;
+  // Medium i's grid-world point (media/emission.h) at world point p.
+  Vec3 grid_world(int i, const Vec3& p) const;
 };
 
 }  // namespace nimbus

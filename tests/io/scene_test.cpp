@@ -87,7 +87,9 @@ TEST(Scene, BadInputCatalogue) {
       {"/media/1/shape/max", json::array({1, -2, 1}), false,
        "scene.json: /media/1/shape/max: must exceed min on every axis"},
       {"/media/0/sigm_s", 1.0, false,
-       "scene.json: /media/0/sigm_s: unknown field (known here: phase, shape, sigma_a, sigma_s, transform)"},
+       "scene.json: /media/0/sigm_s: unknown field (known here: color_grid, emission, emission_grid, "
+       "intensity, phase, shape, sigma_a, sigma_s, "
+       "temperature_grid, temperature_offset, temperature_scale, transform)"},
       {"/lights/0/direction", json::array({0, 0, 0}), false,
        "scene.json: /lights/0/direction: must have non-zero length"},
       {"/lights/0/direction", json::array({0, 1}), false,

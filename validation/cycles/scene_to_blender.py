@@ -23,6 +23,8 @@ Mapping (docs/validation/cycles.md explains and checks each line):
                = world x, y, z, as nimbus reads it; checked against the file's v lines). diffuse =
                Diffuse BSDF (roughness 0, Color = albedo); holdout = Holdout shader. Cycles surfaces
                are two-sided like nimbus'. Shadow-terminator offsets are set to 0.
+               emission (constant only) = an Emission closure in the volume, Strength = max(emission),
+               Color = emission / max (Cycles adds it per unit length, as nimbus does).
   transform    on media and surfaces: matrix_world = T R_n ... R_1 S (or the row-major matrix) times
                the shape's own placement.
   directional  SUN lamp, Strength = irradiance (W/m^2), Color = irradiance / max, angle = angular
@@ -161,6 +163,13 @@ def volume_material(name, medium):
         a.inputs["Color"].default_value = (*(1.0 - v for v in acolor), 1.0)
         a.inputs["Density"].default_value = ascale
         closures.append(a.outputs[0])
+    # Constant emission (radiance per unit length): an Emission closure in the volume, Strength x Color.
+    ecolor, escale = color_and_scale(medium.get("emission", 0.0))
+    if ecolor and escale > 0.0:
+        e = nt.nodes.new("ShaderNodeEmission")
+        e.inputs["Color"].default_value = (*ecolor, 1.0)
+        e.inputs["Strength"].default_value = escale
+        closures.append(e.outputs[0])
     while len(closures) > 1:
         add = nt.nodes.new("ShaderNodeAddShader")
         nt.links.new(closures.pop(), add.inputs[1])
