@@ -107,6 +107,21 @@ Rgb OctaveIntegrator::Li(const Ray& ray, Rng& rng, CameraSample* sample) const {
   return L + Le;
 }
 
+void OctaveIntegrator::sample_lights(const Vec3& p, Rng& rng, LightSamples* lights) const {
+  for (size_t l = 0; l < ctx_.lights.size(); ++l) {
+    const double u1 = rng.uniform(), u2 = rng.uniform();
+    LightSample& ls = lights->ls[l];
+    bool ok = sample_light(ctx_.lights[l], p, u1, u2, &ls);
+    if (ok && ctx_.surfaces.occluded(p, ls.wi, ls.distance)) ok = false;  // a surface shadows p
+    if (ok && is_area_light(ctx_.lights[l]))  // the sampled point of an area light, marched
+      lights->T[l] =
+          marched_transmittance(ctx_.media, ctx_.majorants, p, ls.wi, ls.distance, kSurfaceShadowStep);
+    else if (ok)
+      lights->T[l] = maps_[l].lookup(p);
+    lights->ok[l] = ok;
+  }
+}
+
 Rgb OctaveIntegrator::trace(const Ray& ray, Rng& rng, CameraSample* sample, int bounces) const {
   const Vec3 &o = ray.o, &d = ray.d;
   SurfaceHit hit;
@@ -135,18 +150,7 @@ Rgb OctaveIntegrator::trace(const Ray& ray, Rng& rng, CameraSample* sample, int 
     L += L_step;
     if (max_component(mp.sigma_s) > 0.0) {
       const Rgb tau_here = tau + mp.sigma_t() * (jitter * dt);
-      // Light transmittance exp(-tau_l) once per light (octave j: raised to b^j).
-      for (size_t l = 0; l < ctx_.lights.size(); ++l) {
-        const double u1 = rng.uniform(), u2 = rng.uniform();
-        lights.ok[l] = sample_light(ctx_.lights[l], p, u1, u2, &lights.ls[l]);
-        if (lights.ok[l] && ctx_.surfaces.occluded(p, lights.ls[l].wi, lights.ls[l].distance))
-          lights.ok[l] = false;                             // a surface shadows p
-        if (lights.ok[l] && is_area_light(ctx_.lights[l]))  // the sampled point of an area light, marched
-          lights.T[l] = marched_transmittance(ctx_.media, ctx_.majorants, p, lights.ls[l].wi,
-                                              lights.ls[l].distance, kSurfaceShadowStep);
-        else if (lights.ok[l])
-          lights.T[l] = maps_[l].lookup(p);
-      }
+      sample_lights(p, rng, &lights);  // exp(-tau_l) once per light (octave j: raised to b^j)
       // Octave j: scattering a^j sigma_s seen through the camera-side transmittance exp(-b^j tau).
       for (int j = 0; j < N; ++j) {
         Rgb Tc;

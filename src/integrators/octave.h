@@ -63,6 +63,9 @@ class OctaveIntegrator final : public Integrator {
   // What octave j (extinction scale bj = b^j) scatters towards the camera at p, per unit of a^j dt.
   Rgb octave_scatter(int j, double bj, const Vec3& p, const Vec3& d, const MediumPoint& mp,
                      const LightSamples& lights, Rng& rng) const;
+  // One sample of every light from p and its transmittance exp(-tau_l) (the map's, or marched to an
+  // area light's sampled point); a light a surface hides is not ok.
+  void sample_lights(const Vec3& p, Rng& rng, LightSamples* lights) const;
 
   const SceneContext& ctx_;
   OctaveSettings s_;

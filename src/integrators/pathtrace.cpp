@@ -173,6 +173,15 @@ bool PathTracer::collide(const MediumPoint& mp, double maj, Rgb& beta, Rng& rng,
   return true;
 }
 
+// Russian roulette on the largest channel of the throughput, from the fourth event on.
+bool survives_roulette(int events, Rgb& beta, Rng& rng) {
+  if (events < 3) return true;
+  const double q = std::min(1.0, max_component(beta));
+  if (rng.uniform() >= q) return false;
+  beta /= q;
+  return true;
+}
+
 Rgb PathTracer::Li(const Ray& ray, Rng& rng, CameraSample* sample) const {
   Rgb L(0.0), beta(1.0);
   Vec3 o = ray.o, d = ray.d;
@@ -223,12 +232,7 @@ Rgb PathTracer::Li(const Ray& ray, Rng& rng, CameraSample* sample) const {
       o = scatter_p;
     }
 
-    // Russian roulette on the largest channel of the throughput.
-    if (events >= 3) {
-      const double q = std::min(1.0, max_component(beta));
-      if (rng.uniform() >= q) break;
-      beta /= q;
-    }
+    if (!survives_roulette(events, beta, rng)) break;
   }
   const Rgb Le = visible_area_lights(ctx_, ray, rng);  // what the camera sees of lights (else NEE only)
   L += Le, first.direct += Le;
