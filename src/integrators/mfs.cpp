@@ -5,6 +5,7 @@
 #include "core/json_reader.h"
 #include "integrators/area_light_view.h"
 #include "integrators/camera_layers.h"
+#include "integrators/env_light.h"
 #include "integrators/mfs_estimators.h"
 #include "integrators/surface_light.h"
 #include "integrators/tracking.h"
@@ -212,17 +213,12 @@ MfsIntegrator::MediumRadiance MfsIntegrator::medium_radiance(int i, const Vec3& 
   const PhaseSplit& split = *splits_[i];
   const double f = f_[i];
   MediumRadiance out{Rgb(0.0), Rgb(0.0), Rgb(0.0)};
-  // Sample every light once (u1, u2, in this order) and add its first wide scatter and forward peak.
-  for (size_t l = 0; l < ctx_.lights.size(); ++l) {
-    LightSample ls;
-    const double u1 = rng.uniform(), u2 = rng.uniform();
-    if (!sample_light(ctx_.lights[l], p, u1, u2, &ls)) continue;
-    if (ctx_.surfaces.occluded(p, ls.wi, ls.distance)) continue;  // a surface shadows y
+  // A light's first wide scatter and forward peak at p, from its sample ls and the beam towards it.
+  auto add_light = [&](const LightSample& ls, const LightBeam& beam) {
     const double mu = dot(d, ls.wi);
-    const LightBeam beam = light_beam(l, i, p, ls);
     if (s_.light_side()) {
       out.L += light_side_scatter(ls.weight, f, split, mu, beam.tau_ps, beam.T_wide);  // eq. D11
-      continue;
+      return;
     }
     if (s_.large_angle_scatters != 0)  // eq. D7, first term
       out.L += first_wide_scatter(ls.weight, f, split, mu, y.tau_p, s_.light_blur ? beam.tau_ps : Rgb(0.0),
@@ -231,11 +227,41 @@ MfsIntegrator::MediumRadiance MfsIntegrator::medium_radiance(int i, const Vec3& 
       out.L_peak += forward_peak(ls.weight, f, split, mu, beam.tau_ps, beam.T_wide);
     else  // eq. D7b (beer_lambert)
       out.L += forward_peak(ls.weight, f, split, mu, y.tau_p, beam.T_light);
+  };
+  // Sample every light once (u1, u2, in this order).
+  for (size_t l = 0; l < ctx_.lights.size(); ++l) {
+    LightSample ls;
+    const double u1 = rng.uniform(), u2 = rng.uniform();
+    if (!sample_light(ctx_.lights[l], p, u1, u2, &ls)) continue;
+    if (ctx_.surfaces.occluded(p, ls.wi, ls.distance)) continue;  // a surface shadows y
+    add_light(ls, light_beam(l, i, p, ls));
+  }
+  // An environment image is one more light: a direction drawn as its photons leave it (the image by
+  // luminance, with any constant part), so that the grid, which carries the image's photons only
+  // after their first wide scatter, and this term share its light without overlap.
+  if (ctx_.env_map) {
+    const double u1 = rng.uniform(), u2 = rng.uniform();
+    LightSample ls;
+    double pdf = 0.0;
+    ls.wi = env_photon_direction(ctx_, u1, u2, &pdf);
+    if (pdf > 0.0 && !ctx_.surfaces.occluded(p, ls.wi, ls.distance)) {
+      ls.weight = ctx_.environment_radiance(ls.wi) / pdf;
+      add_light(ls, environment_beam(i, p, ls.wi));
+    }
   }
   // Add the light that already took wide scatters (and the environment's): its last wide scatter is at y.
   out.L_lights = out.L;
   if (grid_) out.L += higher_orders(i, p, d, t, y.tau_p, cam);
   return out;
+}
+
+LightBeam MfsIntegrator::environment_beam(int i, const Vec3& p, const Vec3& wi) const {
+  Rgb T_light, T_wide;
+  marched_full_and_reduced(ctx_, p, wi, std::numeric_limits<double>::infinity(), kSurfaceShadowStep, f_,
+                           &T_light, &T_wide);
+  if (!s_.forward_light_path()) T_wide = T_light;
+  return peak_only_beam(T_light, T_wide, false, Rgb(1.0), Rgb(1.0), splits_[i]->peak_moments(), theta2_[i],
+                        s_.forward_light_path() && s_.path_lengthening);
 }
 
 LightBeam MfsIntegrator::light_beam(size_t l, int i, const Vec3& p, const LightSample& ls) const {

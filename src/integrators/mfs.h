@@ -134,6 +134,8 @@ class MfsIntegrator final : public Integrator {
   // Light l's peak-only beam at p for medium i: shadow maps, beam grid (eqs. D8, D9); an area light
   // marches to its sampled point ls instead of reading a map.
   LightBeam light_beam(size_t l, int i, const Vec3& p, const LightSample& ls) const;
+  // The beam from the environment image along wi (marched: full and reduced transmittance, no beam grid).
+  LightBeam environment_beam(int i, const Vec3& p, const Vec3& wi) const;
   // The scatter grid's light, taking its last wide scatter at p towards the camera (eq. D12).
   Rgb higher_orders(int i, const Vec3& p, const Vec3& d, double t, const Rgb& tau_p,
                     const CameraPath& cam) const;

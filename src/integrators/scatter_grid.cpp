@@ -118,10 +118,13 @@ void ScatterPhotons::trace(size_t j, Rng& rng, PhotonBatch& batch) const {
   const int pass = int(j / (sources * per_source));
   size_t source = (j / per_source) % sources;
   if (source >= lights) source = ctx.lights.size();  // the environment
-  // The environment's light is smooth in angle: the grid carries it from its entry (order 0).
+  // The constant environment's light is smooth in angle: the grid carries it from its entry (order 0).
   // So is the media's emission (isotropic, the last source): the grid carries it from its first flight.
+  // An environment image is not (a sun in it): like a light, mfs takes its first wide scatter on the
+  // camera march, and the grid carries its photons after that.
   const bool from_media = emission && (j / per_source) % sources == sources - 1;
-  const int first_order = source < ctx.lights.size() && !from_media ? 1 : 0;
+  const bool light_like = source < ctx.lights.size() || (source == ctx.lights.size() && ctx.env_map);
+  const int first_order = light_like && !from_media ? 1 : 0;
   const int c = pass;  // the channel whose coefficients drive this photon
   const Photon ph = from_media ? emit_from_media(*emission, ctx.media, double(per_source), rng)
                                : emit(ctx, source, centre, radius, double(per_source), rng);
