@@ -80,8 +80,11 @@ TEST(CliArgs, SetAndResOverrideTheScene) {
   const Image img = read_exr(out, &meta);
   EXPECT_EQ(img.width, 24);
   EXPECT_EQ(img.height, 12);
-  for (const auto& [k, v] : meta)
-    if (k == "nimbus/integrator") EXPECT_EQ(v, "single");
+  for (const auto& [k, v] : meta) {
+    if (k == "nimbus/integrator") {
+      EXPECT_EQ(v, "single");
+    }
+  }
   std::tie(code, err) = run("render --set media.3.sigma_s=1 -o " + (dir / "b.exr").string());
   EXPECT_EQ(code, 2);
   EXPECT_NE(err.find("--set media.3.sigma_s"), std::string::npos) << err;
