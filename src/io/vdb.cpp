@@ -347,12 +347,15 @@ void check_tree_nodes(GridBytes& b, uint64_t root_off) {
   }
 }
 
-// The node manager (used by the full checksum) trusts the tree's node counts and first-node offsets.
+// The node manager (used by the full checksum) trusts the tree's node counts and first-node offsets,
+// and takes the address of every level's first node, even of a level without nodes (a pointer far
+// past the buffer is undefined behaviour before anything reads it).
 void check_node_arrays(const GridBytes& b, uint64_t tree_off) {
   const auto* td = b.at<nanovdb::TreeData<3>>(tree_off);
   const bool breadth_first = b.at<nanovdb::FloatGrid>(0)->isBreadthFirst();
   for (int l = 0; l < 3; ++l) {
     if (td->mNodeCount[l] != b.nodes[l]) b.corrupt(fmt::format("node count mismatch at level {}", l));
+    if (td->mNodeOffset[l] > b.size) b.corrupt(fmt::format("node array at level {} lies past the buffer", l));
     const uint64_t node_size = l == 0 ? sizeof(LeafT) : l == 1 ? sizeof(LowerT) : sizeof(UpperT);
     if (b.nodes[l] > 0 && breadth_first) {
       const uint64_t first = tree_off + td->mNodeOffset[l];

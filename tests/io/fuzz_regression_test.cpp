@@ -99,6 +99,17 @@ TEST(FuzzRegression, NanoVdbLongGridNameIsBoundsChecked) {
   EXPECT_NE(msg.find("blind metadata outside the buffer"), std::string::npos) << msg;
 }
 
+// vdb_fuzz in CI (make fuzz-smoke, UBSan pointer overflow in nanovdb's Tree::getFirstNode): a grid with a
+// checksum whose tree has no nodes but whose first-leaf offset lies 2^62 bytes past the buffer (here the
+// checksummed tiny grid with its root tile made a value tile, the node counts zeroed and the leaf offset
+// set). The checksum's node manager took the address of every level's first node; the structural
+// check now refuses such an offset first.
+TEST(FuzzRegression, NanoVdbNodeOffsetOfAnEmptyLevelIsChecked) {
+  expect_clean_error("nvdb_node_offset_past_buffer.nvdb");
+  const std::string msg = test::load_error(fuzz_input("nvdb_node_offset_past_buffer.nvdb"));
+  EXPECT_NE(msg.find("node array at level 0 lies past the buffer"), std::string::npos) << msg;
+}
+
 // A BLOSC NanoVDB grid whose header claims another grid index: GridHandle::grid<float>() hops
 // mGridSize bytes per index to find it (heap overflow read), and the loader called it before the
 // structural check. The loader no longer uses it on file data.
