@@ -27,6 +27,9 @@ extern "C" void on_signal(int sig) {
   g_cancel.store(true);
 }
 
+// render --noise without --spp: the most samples a pixel may take.
+constexpr int kAdaptiveDefaultMaxSpp = 4096;
+
 struct RenderArgs {
   std::string scene;
   std::string output;
@@ -44,6 +47,8 @@ struct RenderArgs {
   std::string resume;             // --resume: the EXR to continue
   std::vector<std::string> sets;  // --set PATH=VALUE
   std::string res;                // --res WxH
+  double noise = 0.0;             // --noise: adaptive sampling to this binned relative RMSE
+  int noise_bin = 4;              // --noise-bin
   bool quiet = false;
 };
 
@@ -109,7 +114,7 @@ Scene resume_scene(const RenderArgs& args, FilmState* state, std::optional<int>*
   scene.file = file;
   const int requested = scene.integrator.spp;
   *spp = args.spp ? *args.spp : requested;
-  if (**spp <= state->spp)
+  if (**spp <= state->spp && args.noise <= 0.0)
     throw Error(
         fmt::format("--resume: {} has {} spp already; ask for more with --spp", args.resume, state->spp));
   return scene;
@@ -161,7 +166,10 @@ int run_render(RenderArgs args) {
     options.resume = &state;
   } else {
     options.spp = args.spp;
+    if (args.noise > 0.0 && !args.spp) options.spp = kAdaptiveDefaultMaxSpp;
   }
+  options.noise = args.noise;
+  options.noise_bin = args.noise_bin;
   const Scene scene = resumed ? std::move(*resumed) : load_render_scene(args);
   options.seed = args.seed;
   options.integrator = args.integrator;
@@ -204,7 +212,13 @@ int run_render(RenderArgs args) {
   if (result.time_limited)
     fmt::print(stderr, "nimbus: time limit of {} s reached at {} of {} spp\n", args.time_limit, result.spp,
                result.spp_requested);
-  if (!args.quiet) {
+  if (!args.quiet && result.noise_target > 0.0) {
+    fmt::print(stderr,
+               "nimbus: {} {}x{} adaptive: {:.1f} spp on average (at most {}), estimated noise {:.2f} % "
+               "(target {:.2f} %) in {:.2f}s -> {}\n",
+               result.integrator, result.image.width, result.image.height, result.spp_mean, result.spp,
+               100.0 * result.noise_estimate, 100.0 * result.noise_target, result.seconds, out.string());
+  } else if (!args.quiet) {
     fmt::print(stderr, "nimbus: {} {}x{} {} spp in {:.2f}s -> {}\n", result.integrator, result.image.width,
                result.image.height, result.spp, result.seconds, out.string());
   }
@@ -247,6 +261,13 @@ void add_render_command(CLI::App& app, Action& action) {
                   "camera.width or media.0.sigma_s, VALUE JSON (2, [1,0,0], true) or a string; repeatable")
       ->allow_extra_args(false)
       ->take_all();
+  cmd->add_option("--noise", args->noise,
+                  "Adaptive sampling: render until the estimated binned relative RMSE (as nimbus compare "
+                  "--bin K --min-ref 0.05 against a noise-free image) is at most this, e.g. 0.02; --spp is "
+                  "then the most samples a pixel may take (default 4096)")
+      ->check(CLI::Range(0.0, 1.0));
+  cmd->add_option("--noise-bin", args->noise_bin, "The bin size K of --noise (default 4)")
+      ->check(CLI::Range(1, 1024));
   cmd->add_option("--res", args->res, "Image size WIDTHxHEIGHT (sets camera.width and camera.height)");
   cmd->add_option("--time", args->time_limit,
                   "Time budget in seconds, set-up included: whole passes (1, 2, 4, ... spp) while they fit")

@@ -39,6 +39,11 @@ struct RenderOptions {
   // from its spp to the requested one. Needs the same scene, seed and film; the result equals, bit for
   // bit, the render made in one go. Not with a deep image.
   const FilmState* resume = nullptr;
+  // > 0: adaptive sampling (render --noise). Passes go on until the estimated binned relative RMSE
+  // against a noise-free image (nimbus compare --bin noise_bin --min-ref 0.05) is at most `noise`,
+  // each pixel taking samples as its variance asks; the spp is then the most any pixel may take.
+  double noise = 0.0;
+  int noise_bin = 4;
 };
 
 // The passes of a progressive render: from `done` samples per pixel the next pass goes to twice as many
@@ -61,8 +66,11 @@ struct RenderResult {
   int64_t nonfinite_samples = 0;  // NaN/inf samples found and dropped by the film (in this run)
   double seconds = 0.0;
   std::string integrator;
-  int spp = 0;            // samples per pixel in the image (every pixel has as many)
-  int spp_requested = 0;  // what the render asked for
+  int spp = 0;                  // samples per pixel in the image (adaptive: the most any pixel took)
+  double spp_mean = 0.0;        // the mean over pixels (adaptive sampling; = spp otherwise)
+  double noise_target = 0.0;    // RenderOptions::noise (0: not adaptive)
+  double noise_estimate = 0.0;  // adaptive sampling: the estimated binned relative RMSE reached
+  int spp_requested = 0;        // what the render asked for
   uint64_t seed = 0;
   // The integrator block as rendered: type, spp, seed, max_events and the integrator's own fields with
   // "auto" choices resolved (also in the EXR header as nimbus/integrator_settings).

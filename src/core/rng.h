@@ -36,6 +36,24 @@ class Rng {
     const uint32_t rot = uint32_t(old >> 59u);
     return (xorshifted >> rot) | (xorshifted << ((~rot + 1u) & 31));
   }
+  // How many numbers (next_u32 calls) this stream has drawn since it was at state `from`: the PCG
+  // state's distance along its sequence, found bit by bit from the lowest (the low k bits of an LCG
+  // repeat with period 2^k). Adaptive sampling takes it as a sample's cost, the same on any machine.
+  uint64_t draws_since(uint64_t from) const {
+    uint64_t cur = from, mult = 6364136223846793005ull, inc = inc_, bit = 1, steps = 0;
+    while (cur != state_ && bit != 0) {
+      if ((cur & bit) != (state_ & bit)) {
+        cur = cur * mult + inc;
+        steps |= bit;
+      }
+      bit <<= 1;
+      inc = (mult + 1) * inc;
+      mult *= mult;
+    }
+    return steps;
+  }
+  uint64_t state() const { return state_; }
+
   // Uniform in [0, 1), 53 random bits.
   double uniform() {
     const uint64_t hi = next_u32(), lo = next_u32();

@@ -44,6 +44,11 @@ class Film {
   int width() const { return width_; }
   int height() const { return height_; }
   uint32_t samples(int x, int y) const { return count_[index(x, y)]; }
+  // A layer's sums at (x, y): `channels` doubles.
+  const double* sums(int layer, int x, int y) const {
+    const Layer& l = layers_[size_t(layer)];
+    return &l.sum[size_t(l.channels) * index(x, y)];
+  }
   // The "rgb" layer's pixel means (sum / samples; 0 where a pixel has no samples).
   Image resolve() const;
   // Any layer's pixel means, `channels` floats per pixel, row 0 at the top.

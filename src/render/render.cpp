@@ -20,6 +20,7 @@
 
 #include "integrators/registry.h"
 #include "nimbus/error.h"
+#include "render/adaptive.h"
 #include "render/deep.h"
 #include "render/film.h"
 #include "render/film_layers.h"
@@ -49,6 +50,10 @@ IntegratorSettings resolve_settings(const Scene& scene, const RenderOptions& opt
   if (options.layers) check_film_layers(*options.layers);  // before any precomputation
   if (!(options.time_limit >= 0.0 && options.time_limit < 1e9)) throw Error("time limit must be >= 0 s");
   if (options.resume && options.deep_samples > 0) throw Error("a deep image cannot be resumed");
+  if (!(options.noise >= 0.0 && options.noise < 1e3)) throw Error("noise target must be >= 0");
+  if (options.noise > 0.0 && options.deep_samples > 0)
+    throw Error("adaptive sampling (noise target) cannot make a deep image");
+  if (options.noise_bin < 1 || options.noise_bin > 1024) throw Error("noise bin must be between 1 and 1024");
   if (options.deep_samples < 0 || options.deep_samples > kMaxDeepSamples)
     throw Error(fmt::format("deep samples must be between 1 and {} (0: no deep image)", kMaxDeepSamples));
   return settings;
@@ -72,6 +77,7 @@ struct PixelTargets {
   const FilmLayers& layers;
   int deep_samples = 0;                               // 0: no deep image
   std::vector<std::vector<DeepSample>>* deep_pixels;  // per pixel, when deep_samples > 0
+  int adaptive_layer = -1;  // adaptive sampling: the film layer of kAdaptiveLayer (render/adaptive.h)
 };
 
 // Samples of pixel (x, y) into the film. Positions in the pixel: the R2 sequence (Roberts 2018), shifted
@@ -96,10 +102,18 @@ int64_t render_pixel(const Integrator& integrator, const PinholeCamera& camera,
     sample.depth_wanted = to.layers.depth_wanted();
     sample_segments.clear();
     if (to.deep_samples > 0) sample.deep = &sample_segments;
+    const uint64_t rng_start = rng.state();
     const Rgb L = integrator.Li(camera.generate_ray(x + jx, y + jy), rng, &sample);
+    const double* rgb = to.film.sums(0, x, y);
+    const double before = to.adaptive_layer >= 0 ? 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2] : 0.0;
     if (!to.layers.add(to.film, x, y, L, sample)) {
       ++bad;
       continue;  // a dropped sample adds nothing to the deep pixel either
+    }
+    if (to.adaptive_layer >= 0) {  // the luminance the film took (less a transparent film's background)
+      const double lum = 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2] - before;
+      const double a[kAdaptiveChannels] = {lum * lum, double(rng.draws_since(rng_start))};
+      to.film.add(to.adaptive_layer, x, y, a);
     }
     segments.insert(segments.end(), sample_segments.begin(), sample_segments.end());
   }
@@ -142,6 +156,9 @@ struct PassContext {
   std::atomic<int64_t> done{0};  // pixel samples finished (over all passes)
   int64_t total = 0;             // pixel samples to take
   int64_t nonfinite = 0;         // in whole passes
+  // Adaptive sampling: each pixel's sample count after the pass (its samples [count, target) are taken);
+  // null: samples [s0, s1) of every pixel.
+  const std::vector<uint32_t>* target = nullptr;
 };
 
 // Samples [s0, s1) of every pixel, tile by tile over oneTBB. Returns false when stopped part-way (the
@@ -154,18 +171,25 @@ bool render_pass(PassContext& pc, tbb::task_arena& arena, int s0, int s1) {
   auto render_tile = [&](int64_t tile) {
     const int x0 = int(tile % tiles_x) * ts, y0 = int(tile / tiles_x) * ts;
     const int x1 = std::min(x0 + ts, W), y1 = std::min(y0 + ts, H);
-    int64_t tile_bad = 0;
+    int64_t tile_bad = 0, tile_samples = 0;
     for (int y = y0; y < y1; ++y) {
       // Stay responsive inside long tiles: the pass is abandoned.
       if (stopped.load(std::memory_order_relaxed) || pc.stop()) {
         stopped = true;
         return;
       }
-      for (int x = x0; x < x1; ++x)
-        tile_bad += render_pixel(pc.integrator, pc.camera, pc.settings, x, y, s0, s1, pc.targets);
+      for (int x = x0; x < x1; ++x) {
+        int a = s0, b = s1;
+        if (pc.target) {
+          a = int(pc.targets.film.samples(x, y));
+          b = int((*pc.target)[size_t(y) * size_t(W) + size_t(x)]);
+        }
+        tile_bad += render_pixel(pc.integrator, pc.camera, pc.settings, x, y, a, b, pc.targets);
+        tile_samples += b - a;
+      }
     }
     bad += tile_bad;
-    const int64_t done = pc.done += int64_t(x1 - x0) * (y1 - y0) * (s1 - s0);
+    const int64_t done = pc.done += tile_samples;
     if (pc.options.progress) pc.options.progress(done, pc.total, done);
   };
   arena.execute([&] {
@@ -202,6 +226,9 @@ ImageMetadata render_metadata(const Scene& scene, const RenderResult& result, co
       {"nimbus/partial", result.partial ? "true" : "false"},
       {"nimbus/time_limited", result.time_limited ? "true" : "false"},
       {"nimbus/render_seconds", fmt::format("{:.3f}", result.seconds)},
+      {"nimbus/spp_mean", fmt::format("{:.3f}", result.spp_mean)},
+      {"nimbus/noise_target", fmt::format("{}", result.noise_target)},
+      {"nimbus/noise_estimate", fmt::format("{:.5f}", result.noise_estimate)},
   };
 }
 
@@ -233,21 +260,30 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
   result.integrator = settings.type;
   result.spp_requested = settings.spp;
   result.seed = settings.seed;
+  result.noise_target = options.noise;
   const int W = scene.camera.width, H = scene.camera.height;
   Film film(W, H);
   FilmSettings film_settings = scene.film;
   if (options.layers) film_settings.layers = *options.layers;
   const FilmLayers layers(film, film_settings, context->has_environment);
+  const bool adaptive = options.noise > 0.0;
+  const bool resumed_adaptive =
+      options.resume && std::any_of(options.resume->layers.begin(), options.resume->layers.end(),
+                                    [](const FilmState::Layer& l) { return l.name == kAdaptiveLayer; });
+  if (adaptive && options.resume && !resumed_adaptive)
+    throw Error("resume: adaptive sampling continues only a render made with a noise target");
+  const int adaptive_layer =
+      adaptive || resumed_adaptive ? film.add_layer(kAdaptiveLayer, kAdaptiveChannels) : -1;
   int done = 0;
   if (options.resume) {
     film.restore(*options.resume);
     done = options.resume->spp;
-    if (done > settings.spp)
+    if (done > settings.spp && !adaptive)
       throw Error(
           fmt::format("resume: the image has {} spp, more than the {} asked for", done, settings.spp));
   }
   std::vector<std::vector<DeepSample>> deep_pixels(options.deep_samples > 0 ? size_t(W) * size_t(H) : 0);
-  const PixelTargets targets{film, layers, options.deep_samples, &deep_pixels};
+  const PixelTargets targets{film, layers, options.deep_samples, &deep_pixels, adaptive_layer};
 
   bool first = true;
   auto cancelled = [&] { return options.cancel && options.cancel->load(std::memory_order_relaxed); };
@@ -261,7 +297,7 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
   pc.total = int64_t(W) * H * (settings.spp - done);
   const bool stoppable = options.cancel || options.time_limit > 0.0;
   double seconds_per_spp = 0.0;
-  while (done < settings.spp) {
+  while (done < settings.spp && !adaptive) {
     int next = options.deep_samples > 0 ? settings.spp : next_pass_spp(done, settings.spp);
     if (!first && options.time_limit > 0.0) {  // only passes that fit the budget, as measured so far
       const double fit = 0.95 * (options.time_limit - seconds_since(start)) / seconds_per_spp;
@@ -282,7 +318,42 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
     done = next;
     first = false;
   }
-  if (done < settings.spp && !result.time_limited) result.partial = true;
+  if (done < settings.spp && !result.time_limited && !adaptive) result.partial = true;
+  // Adaptive sampling: passes planned from the film's per-pixel variances (render/adaptive.h).
+  const AdaptiveSettings adapt{options.noise, options.noise_bin, 0.05, std::min(8, settings.spp),
+                               settings.spp};
+  for (int pass = 1; adaptive; ++pass) {
+    AdaptivePlan plan = plan_adaptive_pass(film, adaptive_layer, adapt);
+    result.noise_estimate = plan.estimated_error;
+    if (plan.new_samples == 0) break;
+    const double per_sample = pass > 1 ? seconds_per_spp / (double(W) * H) : 0.0;
+    if (!first && options.time_limit > 0.0 &&
+        !(0.95 * (options.time_limit - seconds_since(start)) >= per_sample * double(plan.new_samples))) {
+      result.time_limited = true;
+      break;
+    }
+    if (options.setup && !first)
+      options.setup(fmt::format("adaptive pass {}: noise {:.2f} % (target {:.2f} %)", pass,
+                                100.0 * plan.estimated_error, 100.0 * options.noise));
+    pc.target = &plan.target;
+    pc.total = pc.done + plan.new_samples;
+    const FilmState before = stoppable ? film.state(done) : FilmState{};
+    const auto pass_start = Clock::now();
+    if (!render_pass(pc, arena, 0, 0)) {
+      film.restore(before);
+      (cancelled() ? result.partial : result.time_limited) = true;
+      break;
+    }
+    seconds_per_spp = seconds_since(pass_start) / double(plan.new_samples) * (double(W) * H);
+    first = false;
+  }
+  double count_sum = 0.0;
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      count_sum += film.samples(x, y);
+      if (adaptive) done = std::max(done, int(film.samples(x, y)));
+    }
+  result.spp_mean = count_sum / (double(W) * H);
 
   result.spp = done;
   result.image = layers.resolve(film);

@@ -96,9 +96,10 @@ TEST(Progressive, CancelledRenderIsTheWholeImageOfItsLastPass) {
   two.spp = 2;
   expect_same_image(render(scene, two), r);
   // The samples layer says so in every pixel.
-  for (const ImageChannel& c : r.image.channels)
-    if (c.name == "samples.X")
-      for (float v : c.data) ASSERT_EQ(v, 2.0f);
+  for (const ImageChannel& c : r.image.channels) {
+    if (c.name != "samples.X") continue;
+    for (float v : c.data) ASSERT_EQ(v, 2.0f);
+  }
 }
 
 TEST(Progressive, TimeBudgetKeepsTheFirstPassAndStopsCleanly) {

@@ -1,0 +1,119 @@
+#include "render/adaptive.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace nimbus {
+
+namespace {
+
+double luminance(const double* rgb) { return 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2]; }
+
+// Per pixel: the mean luminance, the unbiased variance of one sample's luminance (0 below 2 samples) and
+// the mean cost of a sample.
+struct PixelStats {
+  std::vector<double> mean, var, cost;
+};
+
+PixelStats pixel_stats(const Film& film, int layer) {
+  const int W = film.width(), H = film.height();
+  const size_t n_px = size_t(W) * size_t(H);
+  PixelStats p{std::vector<double>(n_px, 0.0), std::vector<double>(n_px, 0.0),
+               std::vector<double>(n_px, kSampleOverheadDraws)};
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      const double n = film.samples(x, y);
+      if (n < 1) continue;
+      const size_t i = size_t(y) * W + x;
+      const double* a = film.sums(layer, x, y);
+      const double sum = luminance(film.sums(0, x, y)), sum2 = a[0];
+      p.mean[i] = sum / n;
+      p.cost[i] += a[1] / n;
+      if (n >= 2) p.var[i] = std::max(0.0, (sum2 - sum * sum / n) / (n - 1));
+    }
+  return p;
+}
+
+// The mean over the pixel's 3 x 3 neighbours (those inside the image).
+std::vector<double> pooled(const std::vector<double>& var, int W, int H) {
+  std::vector<double> out(var.size(), 0.0);
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      double s = 0.0;
+      int n = 0;
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          const int u = x + dx, v = y + dy;
+          if (u < 0 || v < 0 || u >= W || v >= H) continue;
+          s += var[size_t(v) * W + u];
+          ++n;
+        }
+      out[size_t(y) * W + x] = s / n;
+    }
+  return out;
+}
+
+}  // namespace
+
+AdaptivePlan plan_adaptive_pass(const Film& film, int layer, const AdaptiveSettings& settings) {
+  const int W = film.width(), H = film.height(), k = std::max(1, settings.bin);
+  const PixelStats px = pixel_stats(film, layer);
+  const std::vector<double> v = pooled(px.var, W, H), c = pooled(px.cost, W, H);
+  const int bx = (W + k - 1) / k, by = (H + k - 1) / k;
+  // Per bin: mean luminance, the variance of that mean, its pixel count and sum of sqrt(v) / m.
+  std::vector<double> bin_mean(size_t(bx) * by, 0.0), bin_var(bin_mean.size(), 0.0), bin_m(bin_mean.size());
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      const size_t i = size_t(y) * W + x, b = size_t(y / k) * bx + x / k;
+      const double n = std::max<double>(1.0, film.samples(x, y));
+      bin_mean[b] += px.mean[i];
+      bin_var[b] += v[i] / n;
+      bin_m[b] += 1.0;
+    }
+  double all = 0.0;
+  for (size_t b = 0; b < bin_mean.size(); ++b) {
+    bin_mean[b] /= bin_m[b];
+    bin_var[b] /= bin_m[b] * bin_m[b];
+    all += bin_mean[b];
+  }
+  all /= double(bin_mean.size());
+  std::vector<char> used(bin_mean.size(), 0);
+  double ysum = 0.0, vsum = 0.0, root_sum = 0.0;
+  int used_bins = 0;
+  for (size_t b = 0; b < bin_mean.size(); ++b) {
+    used[b] = bin_mean[b] > 0.0 && bin_mean[b] >= settings.min_reference * all;
+    if (!used[b]) continue;
+    ++used_bins;
+    ysum += bin_mean[b];
+    vsum += bin_var[b];
+  }
+  AdaptivePlan plan;
+  plan.target.resize(size_t(W) * H);
+  const double ybar = used_bins > 0 ? ysum / used_bins : 0.0;
+  plan.estimated_error = ybar > 0.0 ? std::sqrt(vsum / used_bins) / ybar : 0.0;
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      const size_t b = size_t(y / k) * bx + x / k;
+      const size_t i = size_t(y) * W + x;
+      if (used[b]) root_sum += std::sqrt(v[i] * c[i]) / bin_m[b];
+    }
+  // Samples n_i = lambda sqrt(v_i / c_i) / m_b minimise sum_b sum_i v_i / (m_b^2 n_i) for their cost
+  // sum_i c_i n_i, and give the target error for lambda = sum_i sqrt(v_i c_i) / m_b / (bins e^2 ybar^2).
+  const double goal = settings.noise * ybar, lambda = goal > 0.0 ? root_sum / (used_bins * goal * goal) : 0.0;
+  const bool done = plan.estimated_error <= settings.noise;
+  const uint32_t cap = uint32_t(std::max(settings.max_spp, 1));
+  const uint32_t base = std::min(cap, uint32_t(std::max(settings.base_spp, 1)));
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      const size_t i = size_t(y) * W + x, b = size_t(y / k) * bx + x / k;
+      const uint32_t n = film.samples(x, y);
+      double want = base;
+      if (!done && used[b]) want = std::max(want, std::ceil(lambda * std::sqrt(v[i] / c[i]) / bin_m[b]));
+      const double grown = std::min({want, 2.0 * std::max<double>(n, 1.0), double(cap)});
+      plan.target[i] = std::max(n, uint32_t(grown));
+      plan.new_samples += plan.target[i] - n;
+    }
+  return plan;
+}
+
+}  // namespace nimbus
