@@ -74,6 +74,12 @@ int run_beam(const BeamArgs& a) {
   if (!a.theta_edges.empty()) s.theta_edges = parse_number_list("--theta-edges", a.theta_edges);
   if (!a.r_edges.empty()) s.r_edges = parse_number_list("--r-edges", a.r_edges);
   if (a.time_given) s.time_edges = parse_time_edges("--time-edges", a.time_edges);
+  // Each batch of the Monte Carlo keeps every delay bin at every depth (photon_mc.h).
+  if (a.time_given && double(s.time_edges.size() + 4) * double(s.depths.size() + 2) > 4e6)
+    throw Error(
+        fmt::format("--time-edges: {} bins at {} depths need more memory than allowed (bins x depths "
+                    "at most about 4e6)",
+                    s.time_edges.size() - 1, s.depths.size()));
   const std::vector<std::string> models = a.models.empty() ? beam_model_names() : split_names(a.models);
   if (models.empty()) throw Error("--models: empty list");
 

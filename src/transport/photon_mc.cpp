@@ -239,7 +239,8 @@ class Tracer {
         const double t = (zs[k] - p0.z) / d.z;
         const int ir = bin_of(s_.r_edges, std::hypot(p0.x + d.x * t, p0.y + d.y * t));
         if (ir >= 0) acc[L_.radial(k) + ir] += w;
-        if (L_.TS > 0) tally_delay(k, s_.n * (path + t - zs[k]), w, turned, acc);
+        // The delay is >= 0; rounding could push a nearly straight path a hair below.
+        if (L_.TS > 0) tally_delay(k, std::max(0.0, s_.n * (path + t - zs[k])), w, turned, acc);
       }
     }
   }

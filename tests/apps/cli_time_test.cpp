@@ -105,25 +105,38 @@ TEST(CliTime, BeamAddsDelayRowsForMcAndMfs) {
   }
 }
 
-TEST(CliTime, BadTimeEdgesExitWithCode2NamingTheArgument) {
+const char* const kBadEdges[] = {"''", "2,1", "-1,1", "0:1:1e9", "5"};
+
+TEST(CliTime, SlabBadTimeEdgesExitWithCode2NamingTheArgument) {
   const auto dir = temp_dir();
   const auto out = dir / "never.csv";
   const std::string slab =
       "slab --mu-s 1 --mu-a 0 --g 0 --thickness 1 --photons 100 --time-csv " + out.string();
-  for (const char* bad : {"''", "2,1", "-1,1", "0:1:1e9", "5"}) {
+  for (const char* bad : kBadEdges) {
     const CliRun r = run(slab + " --time-edges=" + bad);
     EXPECT_EQ(r.rc, 2) << bad << ": " << r.out;
     EXPECT_NE(r.out.find("--time-edges"), std::string::npos) << bad << ": " << r.out;
-    const CliRun b =
-        run("beam --phase hg:0.9 --albedo 0.9 --depths 1 --photons 100 --time-edges=" + std::string(bad));
-    EXPECT_EQ(b.rc, 2) << bad << ": " << b.out;
-    EXPECT_NE(b.out.find("--time-edges"), std::string::npos) << bad << ": " << b.out;
   }
-  EXPECT_FALSE(std::filesystem::exists(out));
   const CliRun r = run(slab);  // --time-csv without --time-edges
   EXPECT_EQ(r.rc, 2) << r.out;
   EXPECT_FALSE(std::filesystem::exists(out));
   std::filesystem::remove_all(dir);
+}
+
+TEST(CliTime, BeamBadTimeEdgesExitWithCode2NamingTheArgument) {
+  const std::string beam = "beam --phase hg:0.9 --albedo 0.9 --photons 100 --depths 1 --time-edges=";
+  for (const char* bad : kBadEdges) {
+    const CliRun b = run(beam + bad);
+    EXPECT_EQ(b.rc, 2) << bad << ": " << b.out;
+    EXPECT_NE(b.out.find("--time-edges"), std::string::npos) << bad << ": " << b.out;
+  }
+  // More bins x depths than the tallies may hold.
+  std::string depths = "0.1";
+  for (int i = 2; i <= 100; ++i) depths += "," + std::to_string(0.1 * i);
+  const CliRun m =
+      run("beam --phase hg:0.9 --albedo 0.9 --photons 100 --time-edges 0:1:100000 --depths " + depths);
+  EXPECT_EQ(m.rc, 2) << m.out;
+  EXPECT_NE(m.out.find("--time-edges"), std::string::npos) << m.out;
 }
 
 }  // namespace
