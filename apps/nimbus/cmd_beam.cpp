@@ -6,6 +6,12 @@
 //   angular     bins of polar angle [rad]; plane-integrated scattered radiance per sr per source photon
 //   radial      bins of radius [mfp]; forward scattered flux per unit area per source photon
 //   unscattered lo = hi = 0; unscattered flux through the plane
+// With --time-edges (t0,t1,... or lo:hi:N, in mfp; time = n * path length):
+//   delay          bins of the delay n (s - z) [mfp] of scattered light crossing the plane forward
+//                  (weight per bin per source photon; rows 0..t0 if t0 > 0 and t_last..inf hold the rest);
+//                  models mc and mfs only
+//   delay_mean     lo = hi = 0; mean delay of that light [mfp]
+//   delay_variance lo = hi = 0; its variance [mfp^2]
 #include <fmt/format.h>
 
 #include <cmath>
@@ -19,13 +25,15 @@
 #include "nimbus/error.h"
 #include "transport/beam_table.h"
 #include "transport/phase_spec.h"
+#include "transport/time_resolved.h"
 
 namespace nimbus::cli {
 
 namespace {
 
 struct BeamArgs {
-  std::string phase, geometry = "infinite", models, theta_edges, r_edges, out;
+  std::string phase, geometry = "infinite", models, theta_edges, r_edges, out, time_edges;
+  bool time_given = false;
   double albedo = -1.0, n = 1.0, photons = 1e6;
   std::string depths;
   uint64_t seed = 1;
@@ -65,6 +73,13 @@ int run_beam(const BeamArgs& a) {
   s.seed = a.seed;
   if (!a.theta_edges.empty()) s.theta_edges = parse_number_list("--theta-edges", a.theta_edges);
   if (!a.r_edges.empty()) s.r_edges = parse_number_list("--r-edges", a.r_edges);
+  if (a.time_given) s.time_edges = parse_time_edges("--time-edges", a.time_edges);
+  // Each batch of the Monte Carlo keeps every delay bin at every depth (photon_mc.h).
+  if (a.time_given && double(s.time_edges.size() + 4) * double(s.depths.size() + 2) > 4e6)
+    throw Error(
+        fmt::format("--time-edges: {} bins at {} depths need more memory than allowed (bins x depths "
+                    "at most about 4e6)",
+                    s.time_edges.size() - 1, s.depths.size()));
   const std::vector<std::string> models = a.models.empty() ? beam_model_names() : split_names(a.models);
   if (models.empty()) throw Error("--models: empty list");
 
@@ -107,8 +122,11 @@ void add_beam_command(CLI::App& app, Action& action) {
   cmd->add_option("--r-edges", args->r_edges, "Radius bin edges [mean free paths], comma-separated");
   cmd->add_option("--seed", args->seed, "Random seed (default 1)");
   cmd->add_option("-o,--output", args->out, "Output CSV (default stdout)");
-  cmd->callback([args, n_opt, &action] {
+  auto* te = cmd->add_option("--time-edges", args->time_edges,
+                             "Delay-bin edges t0,t1,... or lo:hi:N [mfp]: adds delay rows (mc, mfs)");
+  cmd->callback([args, n_opt, te, &action] {
     args->n_given = n_opt->count() > 0;
+    args->time_given = te->count() > 0;
     action = [args] { return run_beam(*args); };
   });
 }

@@ -4,10 +4,16 @@
 // --csv [FILE] adds angle- and radius-resolved reflectance and transmittance (to FILE or stdout):
 //   side,quantity,lo,hi,value,stderr   side = reflect|transmit, quantity = angular (per sr of exit
 //   solid angle, exit polar angle outside the slab, rad) or radial (per unit area, exit radius).
+// --time-edges t0,t1,... or lo:hi:N adds time-resolved exits (to --time-csv FILE, or stdout):
+//   tlo,thi,reflectance,reflectance_stderr,transmittance,transmittance_stderr
+//   time = n * path length in the medium (c = 1 in vacuum), in the length unit of --thickness; values are
+//   fractions of the source photons leaving in [tlo, thi) (divide by thi - tlo for a rate).  A row
+//   0..t0 (if t0 > 0) and a row t_last..inf hold the rest, so the rows sum to the steady values.
 #include <fmt/format.h>
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -16,6 +22,7 @@
 #include "io/atomic_file.h"
 #include "nimbus/error.h"
 #include "transport/photon_mc.h"
+#include "transport/time_resolved.h"
 
 namespace nimbus::cli {
 
@@ -28,10 +35,42 @@ struct SlabArgs {
   double r_max = 0.0;
   bool csv = false;
   std::string csv_path;
+  std::string time_edges, time_csv;
+  bool time_given = false;
 };
+
+// Writes `text` to `path` (or stdout for "" and "-"); false when the file cannot be written.
+bool write_text(const std::string& path, const std::string& text) {
+  if (path.empty() || path == "-") {
+    std::fwrite(text.data(), 1, text.size(), stdout);
+    return true;
+  }
+  try {
+    atomic_write_bytes(path, text);
+  } catch (const Error&) {
+    fmt::print(stderr, "nimbus: error: cannot write {}\n", path);
+    return false;
+  }
+  return true;
+}
+
+// The time-resolved exits as CSV (see the top of this file).
+std::string time_csv(const std::vector<double>& edges, const PhotonMcResult& r) {
+  std::string csv = "tlo,thi,reflectance,reflectance_stderr,transmittance,transmittance_stderr\n";
+  auto row = [&](double lo, double hi, const Estimate& R, const Estimate& T) {
+    csv += fmt::format("{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g}\n", lo, hi, R.value, R.err, T.value, T.err);
+  };
+  if (edges.front() > 0.0) row(0.0, edges.front(), r.reflect_time.before, r.transmit_time.before);
+  for (size_t i = 0; i + 1 < edges.size(); ++i)
+    row(edges[i], edges[i + 1], r.reflect_time.bins[i], r.transmit_time.bins[i]);
+  row(edges.back(), std::numeric_limits<double>::infinity(), r.reflect_time.after, r.transmit_time.after);
+  return csv;
+}
 
 int run_slab(const SlabArgs& a) {
   if (!a.csv_path.empty() && a.csv_path != "-") check_output_path(a.csv_path, "--csv");
+  if (!a.time_csv.empty() && a.time_csv != "-") check_output_path(a.time_csv, "--time-csv");
+  if (!a.time_csv.empty() && !a.time_given) throw Error("--time-csv needs --time-edges");
   if (!(a.mu_s >= 0.0) || !std::isfinite(a.mu_s))
     throw Error(fmt::format("--mu-s must be >= 0 (got {})", a.mu_s));
   if (!(a.mu_a >= 0.0) || !std::isfinite(a.mu_a))
@@ -57,6 +96,7 @@ int run_slab(const SlabArgs& a) {
   s.photons = uint64_t(a.photons);
   s.seed = a.seed;
   s.batches = 20;
+  if (a.time_given) s.time_edges = parse_time_edges("--time-edges", a.time_edges);
   for (int i = 0; i <= a.angle_bins; ++i) s.theta_edges.push_back(0.5 * kPi * i / a.angle_bins);
   const double transport = a.mu_a + a.mu_s * (1.0 - a.g);
   const double r_max =
@@ -74,6 +114,7 @@ int run_slab(const SlabArgs& a) {
   line("unscattered_transmittance", r.unscattered_transmittance);
   line("absorbed", r.absorbed);
   std::fwrite(text.data(), 1, text.size(), stdout);
+  if (a.time_given && !write_text(a.time_csv, time_csv(s.time_edges, r))) return kExitFailure;
   if (!a.csv) return kExitOk;
 
   std::string csv = "side,quantity,lo,hi,value,stderr\n";
@@ -87,17 +128,7 @@ int run_slab(const SlabArgs& a) {
   rows("reflect", "radial", s.r_edges, r.reflect_radial);
   rows("transmit", "angular", s.theta_edges, r.transmit_angular);
   rows("transmit", "radial", s.r_edges, r.transmit_radial);
-  if (a.csv_path.empty() || a.csv_path == "-") {
-    std::fwrite(csv.data(), 1, csv.size(), stdout);
-    return kExitOk;
-  }
-  try {
-    atomic_write_bytes(a.csv_path, csv);
-  } catch (const Error&) {
-    fmt::print(stderr, "nimbus: error: cannot write {}\n", a.csv_path);
-    return kExitFailure;
-  }
-  return kExitOk;
+  return write_text(a.csv_path, csv) ? kExitOk : kExitFailure;
 }
 
 }  // namespace
@@ -121,8 +152,13 @@ void add_slab_command(CLI::App& app, Action& action) {
   auto* csv = cmd->add_option("--csv", args->csv_path,
                               "Also write angle- and radius-resolved tallies (to FILE, or stdout)")
                   ->expected(0, 1);
-  cmd->callback([args, csv, &action] {
+  auto* te = cmd->add_option("--time-edges", args->time_edges,
+                             "Time-bin edges t0,t1,... or lo:hi:N (time = n * path length, in the length "
+                             "unit); writes time-resolved R and T");
+  cmd->add_option("--time-csv", args->time_csv, "File for the --time-edges table (default stdout)");
+  cmd->callback([args, csv, te, &action] {
     args->csv = csv->count() > 0;
+    args->time_given = te->count() > 0;
     action = [args] { return run_slab(*args); };
   });
 }

@@ -7,12 +7,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "core/math.h"
 #include "nimbus/error.h"
 #include "transport/mfs_kernel.h"
 #include "transport/photon_mc.h"
 #include "transport/small_angle.h"
+#include "transport/time_resolved.h"
 
 namespace nimbus {
 
@@ -59,6 +61,7 @@ BeamSettings checked_beam_settings(const BeamSettings& in, const std::vector<std
   }
   if (s.theta_edges.empty()) s.theta_edges = default_theta_edges();
   if (s.r_edges.empty()) s.r_edges = default_r_edges();
+  if (s.time_edges.size() == 1) throw Error("delay edges need at least two values");
   for (const std::vector<double>* e : {&s.theta_edges, &s.r_edges})
     if (e->size() < 2) throw Error("bin edges need at least two values");
   for (const auto& m : models)
@@ -93,6 +96,21 @@ void add_model_rows(std::vector<BeamRow>& rows, const BeamSettings& s, const std
   rows.push_back({name, z, "unscattered", 0.0, 0.0, entry * std::exp(-(1.0 + a) * z), 0.0});
 }
 
+// Rows `delay` of one model at depth z: the bins, a first row from 0 if the first edge is > 0, a last
+// row to infinity.
+template <typename Bin>
+void add_delay_rows(std::vector<BeamRow>& rows, const BeamSettings& s, const std::string& model, double z,
+                    Bin&& bin, const Estimate& before, const Estimate& after) {
+  const auto& e = s.time_edges;
+  if (e.front() > 0.0) rows.push_back({model, z, "delay", 0.0, e.front(), before.value, before.err});
+  for (size_t i = 0; i + 1 < e.size(); ++i) {
+    const Estimate v = bin(i);
+    rows.push_back({model, z, "delay", e[i], e[i + 1], v.value, v.err});
+  }
+  rows.push_back(
+      {model, z, "delay", e.back(), std::numeric_limits<double>::infinity(), after.value, after.err});
+}
+
 // The photon Monte Carlo rows: "mc" if asked, the forward-only "mc_fwd" diagnostic if want_fwd.
 void add_mc_rows(std::vector<BeamRow>& rows, const BeamSettings& s, double a, bool asked, bool want_fwd) {
   const auto& te = s.theta_edges;
@@ -109,19 +127,46 @@ void add_mc_rows(std::vector<BeamRow>& rows, const BeamSettings& s, double a, bo
   mc.photons = s.photons;
   mc.seed = s.seed;
   mc.batches = s.batches;
+  mc.time_edges = s.time_edges;
   const PhotonMcResult r = run_photon_mc(mc);
   for (const PlaneTally& t : r.planes) {
     if (want_fwd)
       for (size_t i = 0; i < t.angular.size(); ++i)
         rows.push_back({"mc_fwd", t.depth, "angular", te[i], te[i + 1], t.angular_forward_only[i].value,
                         t.angular_forward_only[i].err});
+    if (want_fwd && !s.time_edges.empty()) {
+      rows.push_back({"mc_fwd", t.depth, "delay_mean", 0.0, 0.0, t.delay_mean_forward_only.value,
+                      t.delay_mean_forward_only.err});
+      rows.push_back({"mc_fwd", t.depth, "delay_variance", 0.0, 0.0, t.delay_variance_forward_only.value,
+                      t.delay_variance_forward_only.err});
+    }
     if (!asked) continue;
     for (size_t i = 0; i < t.angular.size(); ++i)
       rows.push_back({"mc", t.depth, "angular", te[i], te[i + 1], t.angular[i].value, t.angular[i].err});
     for (size_t i = 0; i < t.radial.size(); ++i)
       rows.push_back({"mc", t.depth, "radial", re[i], re[i + 1], t.radial[i].value, t.radial[i].err});
     rows.push_back({"mc", t.depth, "unscattered", 0.0, 0.0, t.unscattered.value, t.unscattered.err});
+    if (s.time_edges.empty()) continue;
+    add_delay_rows(
+        rows, s, "mc", t.depth, [&](size_t i) { return t.delay.bins[i]; }, t.delay.before, t.delay.after);
+    rows.push_back({"mc", t.depth, "delay_mean", 0.0, 0.0, t.delay_mean.value, t.delay_mean.err});
+    rows.push_back({"mc", t.depth, "delay_variance", 0.0, 0.0, t.delay_variance.value, t.delay_variance.err});
   }
+}
+
+// The corrected MFS kernel's delay rows at depth z (time_resolved.h), times n (time = n * path).
+void add_mfs_delay_rows(std::vector<BeamRow>& rows, const BeamSettings& s, double z, double entry, double a) {
+  const double theta2 = phase_theta2(s.phase), n = s.n, inf = std::numeric_limits<double>::infinity();
+  const auto& e = s.time_edges;
+  auto within = [&](double lo, double hi) {
+    return Estimate{entry * mfs_delay_within(lo / n, hi / n, z, 1.0, a, theta2), 0.0};
+  };
+  add_delay_rows(
+      rows, s, "mfs", z, [&](size_t i) { return within(e[i], e[i + 1]); }, within(0.0, e.front()),
+      within(e.back(), inf));
+  const DelayMoments m = mfs_delay_moments(z, 1.0, a, theta2);
+  rows.push_back({"mfs", z, "delay_mean", 0.0, 0.0, n * m.mean, 0.0});
+  rows.push_back({"mfs", z, "delay_variance", 0.0, 0.0, n * n * m.variance, 0.0});
 }
 
 }  // namespace
@@ -157,6 +202,7 @@ std::vector<BeamRow> beam_table(const BeamSettings& in, const std::vector<std::s
         add_model_rows(
             rows, s, m, z, entry, a, [&](double t) { return g.angular_within(t); },
             [&](double r) { return g.radial_within(r); });
+        if (gm == GaussianModel::Mfs && !s.time_edges.empty()) add_mfs_delay_rows(rows, s, z, entry, a);
       }
     }
   }

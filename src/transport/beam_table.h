@@ -23,12 +23,19 @@ struct BeamSettings {
   int batches = 20;
   std::vector<double> theta_edges;  // rad; empty: default_theta_edges()
   std::vector<double> r_edges;      // mfp; empty: default_r_edges()
+  // Delay-bin edges [mfp] (time_resolved.h); empty: no delay rows.  With them, `mc` adds rows `delay`
+  // (scattered forward crossings by delay n (s - z), weight per bin; a last row up to infinity and, if
+  // the first edge is > 0, a first row from 0 hold the rest), `delay_mean` and `delay_variance`
+  // (lo = hi = 0); `mfs` adds the same rows from its closed form (time_resolved.h); the diagnostic
+  // `mc_fwd` adds delay_mean and delay_variance of photons that never travelled backward.
+  std::vector<double> time_edges;
 };
 
 struct BeamRow {
   std::string model;  // mc, dolin, tes87, mfs, gsa
   double depth = 0.0;
-  std::string quantity;  // angular (per sr), radial (per area), unscattered
+  std::string
+      quantity;  // angular (per sr), radial (per area), unscattered, delay, delay_mean, delay_variance
   double lo = 0.0, hi = 0.0, value = 0.0, stderr_ = 0.0;
 };
 

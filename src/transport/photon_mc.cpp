@@ -40,19 +40,26 @@ constexpr double kRouletteThreshold = 1e-4;  // MCML
 constexpr double kRouletteSurvival = 0.1;    // MCML
 
 // Offsets of every tally in one flat accumulator per batch.
+// Time tallies take TS = NT + 2 slots (before the first edge, the NT bins, after the last; 0 without
+// time bins) and each plane MS = 6 more (delay moments: weight, weight * delay, weight * delay^2, of all
+// scattered forward crossings and of those by photons that never travelled backward).
 struct Layout {
-  size_t P, NA, NR;
-  size_t plane_stride() const { return 2 * NA + NR + 1; }
+  size_t P, NA, NR, TS = 0, MS = 0;
+  size_t plane_stride() const { return 2 * NA + NR + 1 + TS + MS; }
   size_t angular(size_t k) const { return k * plane_stride(); }
   size_t radial(size_t k) const { return k * plane_stride() + NA; }
   size_t unscattered(size_t k) const { return k * plane_stride() + NA + NR; }
   size_t angular_forward_only(size_t k) const { return k * plane_stride() + NA + NR + 1; }
+  size_t delay(size_t k) const { return k * plane_stride() + 2 * NA + NR + 1; }
+  size_t moments(size_t k) const { return delay(k) + TS; }
   size_t totals() const { return P * plane_stride(); }  // specular, Rd, Tt, Tu, absorbed
   size_t reflect_angular() const { return totals() + 5; }
   size_t reflect_radial() const { return reflect_angular() + NA; }
   size_t transmit_angular() const { return reflect_radial() + NR; }
   size_t transmit_radial() const { return transmit_angular() + NA; }
-  size_t size() const { return transmit_radial() + NR; }
+  size_t reflect_time() const { return transmit_radial() + NR; }
+  size_t transmit_time() const { return reflect_time() + TS; }
+  size_t size() const { return transmit_time() + TS; }
 };
 enum Total { kSpecular = 0, kReflect = 1, kTransmit = 2, kUnscatteredT = 3, kAbsorbed = 4 };
 
@@ -60,6 +67,13 @@ enum Total { kSpecular = 0, kReflect = 1, kTransmit = 2, kUnscatteredT = 3, kAbs
 int bin_of(const std::vector<double>& edges, double v) {
   if (edges.size() < 2 || !(v >= edges.front()) || v >= edges.back()) return -1;
   return int(std::upper_bound(edges.begin(), edges.end(), v) - edges.begin()) - 1;
+}
+
+// Slot of time t among the TS time slots (0: before the first edge, TS - 1: at or after the last).
+size_t time_slot(const std::vector<double>& edges, double t) {
+  if (t < edges.front()) return 0;
+  if (t >= edges.back()) return edges.size();
+  return size_t(std::upper_bound(edges.begin(), edges.end(), t) - edges.begin());
 }
 
 void validate(const PhotonMcSettings& s) {
@@ -82,6 +96,18 @@ void validate(const PhotonMcSettings& s) {
     if (!(s.r_edges[i] >= 0.0) || !std::isfinite(s.r_edges[i])) bad("radius edges must be finite and >= 0");
     if (i > 0 && !(s.r_edges[i] > s.r_edges[i - 1])) bad("radius edges must increase");
   }
+  for (size_t i = 0; i < s.time_edges.size(); ++i) {
+    if (!(s.time_edges[i] >= 0.0) || !std::isfinite(s.time_edges[i]))
+      bad("time edges must be finite and >= 0");
+    if (i > 0 && !(s.time_edges[i] > s.time_edges[i - 1])) bad("time edges must increase");
+  }
+  if (s.time_edges.size() == 1) bad("time edges need at least two values");
+  // Every batch holds all tallies: refuse what would not fit in memory (1 GiB of tallies).
+  const double slots = double(s.time_edges.size() + 4) * double(s.plane_depths.size() + 2) +
+                       double(s.theta_edges.size() + s.r_edges.size()) * double(s.plane_depths.size() + 2);
+  if (slots * double(s.batches) * sizeof(double) > double(1u << 30))
+    bad(fmt::format("{} time bins at {} planes need more than 1 GiB of tallies", s.time_edges.size(),
+                    s.plane_depths.size()));
   if (s.batches < 2) bad("needs at least 2 batches");
   if (s.photons < uint64_t(s.batches)) bad("needs at least one photon per batch");
 }
@@ -108,6 +134,7 @@ class Tracer {
     Vec3 p(0.0, 0.0, 0.0), d(0.0, 0.0, 1.0);
     bool scattered = false, turned = false;
     int zone_seen = 0;
+    double path = 0.0;  // path length travelled in the medium
     const double inf = std::numeric_limits<double>::infinity();
     while (true) {
       // Free path, and the distance to the face ahead.
@@ -124,11 +151,12 @@ class Tracer {
       if (!std::isfinite(step)) return;  // moving parallel to the faces of an empty slab
       Vec3 p1 = p + d * step;
       if (hits) p1.z = d.z > 0.0 ? s_.thickness : 0.0;
-      tally_planes(p, p1, d, w, scattered, turned, acc);
+      tally_planes(p, p1, d, path, w, scattered, turned, acc);
       p = p1;
+      path += step;
 
       if (hits) {
-        reflect_at_face(p, d, w, scattered, turned, acc);
+        reflect_at_face(p, d, path, w, scattered, turned, acc);
         if (!(w > 0.0)) return;
       } else {
         interact(rng, d, w, scattered, turned, acc);
@@ -139,11 +167,13 @@ class Tracer {
 
  private:
   // Fresnel at the face: the transmitted part leaves (tallied), the reflected part goes on.
-  void reflect_at_face(const Vec3& p, Vec3& d, double& w, bool scattered, bool& turned, double* acc) const {
+  void reflect_at_face(const Vec3& p, Vec3& d, double path, double& w, bool scattered, bool& turned,
+                       double* acc) const {
     double cos_t = 0.0;
     const double R = fresnel_reflectance(s_.n, 1.0, d.z, &cos_t);
     const double wt = w * (1.0 - R);
-    if (wt > 0.0) tally_exit(d.z > 0.0, std::acos(std::clamp(cos_t, 0.0, 1.0)), p, wt, scattered, acc);
+    if (wt > 0.0)
+      tally_exit(d.z > 0.0, std::acos(std::clamp(cos_t, 0.0, 1.0)), p, s_.n * path, wt, scattered, acc);
     w *= R;
     d.z = -d.z;
     turned = turned || d.z <= 0.0;
@@ -182,9 +212,9 @@ class Tracer {
     return true;
   }
 
-  // Crossings of the tally planes by the segment p0 -> p1 (direction d).
-  void tally_planes(const Vec3& p0, const Vec3& p1, const Vec3& d, double w, bool scattered, bool turned,
-                    double* acc) const {
+  // Crossings of the tally planes by the segment p0 -> p1 (direction d), which starts after `path`.
+  void tally_planes(const Vec3& p0, const Vec3& p1, const Vec3& d, double path, double w, bool scattered,
+                    bool turned, double* acc) const {
     const auto& zs = s_.plane_depths;
     if (zs.empty() || d.z == 0.0) return;
     size_t k0, k1;  // planes [k0, k1) are crossed
@@ -209,14 +239,29 @@ class Tracer {
         const double t = (zs[k] - p0.z) / d.z;
         const int ir = bin_of(s_.r_edges, std::hypot(p0.x + d.x * t, p0.y + d.y * t));
         if (ir >= 0) acc[L_.radial(k) + ir] += w;
+        // The delay is >= 0; rounding could push a nearly straight path a hair below.
+        if (L_.TS > 0) tally_delay(k, std::max(0.0, s_.n * (path + t - zs[k])), w, turned, acc);
       }
     }
   }
 
-  void tally_exit(bool bottom, double theta_out, const Vec3& p, double wt, bool scattered,
+  // A scattered forward crossing of plane k with delay n (s - z_k).
+  void tally_delay(size_t k, double delay, double w, bool turned, double* acc) const {
+    acc[L_.delay(k) + time_slot(s_.time_edges, delay)] += w;
+    double* m = acc + L_.moments(k);
+    for (int part = 0; part < (turned ? 1 : 2); ++part, m += 3) {
+      m[0] += w;
+      m[1] += w * delay;
+      m[2] += w * delay * delay;
+    }
+  }
+
+  void tally_exit(bool bottom, double theta_out, const Vec3& p, double time, double wt, bool scattered,
                   double* acc) const {
     const int ia = bin_of(s_.theta_edges, theta_out);
     const int ir = bin_of(s_.r_edges, std::hypot(p.x, p.y));
+    if (L_.TS > 0)
+      acc[(bottom ? L_.transmit_time() : L_.reflect_time()) + time_slot(s_.time_edges, time)] += wt;
     if (bottom) {
       acc[L_.totals() + kTransmit] += wt;
       if (!scattered) acc[L_.totals() + kUnscatteredT] += wt;
@@ -284,13 +329,47 @@ Estimate batch_estimate(const Batches& batches, uint64_t photons, size_t j, doub
   return Estimate{mean * scale, err * scale};
 }
 
+// The time slots from j on: before, bins, after.
+TimeTally time_tally(const Batches& batches, uint64_t photons, size_t j, size_t TS) {
+  TimeTally t;
+  t.before = batch_estimate(batches, photons, j, 1.0);
+  for (size_t i = 1; i + 1 < TS; ++i) t.bins.push_back(batch_estimate(batches, photons, j + i, 1.0));
+  t.after = batch_estimate(batches, photons, j + TS - 1, 1.0);
+  return t;
+}
+
+// A statistic f(m0, m1, m2) of the delay moments from j on: its value from all photons, its standard
+// error from the spread of the batch values (as batch_estimate does for means).
+Estimate moment_statistic(const Batches& batches, size_t j, double (*f)(double, double, double)) {
+  const int B = int(batches.sums.size());
+  double m[3] = {0.0, 0.0, 0.0}, N = 0.0;
+  for (int b = 0; b < B; ++b) {
+    for (int i = 0; i < 3; ++i) m[i] += batches.sums[b][j + i];
+    N += double(batches.counts[b]);
+  }
+  if (!(m[0] > 0.0)) return Estimate{};
+  const double value = f(m[0], m[1], m[2]);
+  double var = 0.0;
+  for (int b = 0; b < B; ++b) {
+    const double* mb = batches.sums[b].data() + j;
+    const double fb = double(batches.counts[b]) / N;
+    const double xb = mb[0] > 0.0 ? f(mb[0], mb[1], mb[2]) : value;
+    var += fb * fb * (xb - value) * (xb - value);
+  }
+  return Estimate{value, std::sqrt(var * double(B) / double(B - 1))};
+}
+
+double delay_mean(double m0, double m1, double) { return m1 / m0; }
+double delay_variance(double m0, double m1, double m2) { return m2 / m0 - (m1 / m0) * (m1 / m0); }
+
 }  // namespace
 
 PhotonMcResult run_photon_mc(const PhotonMcSettings& s) {
   validate(s);
   const size_t NA = s.theta_edges.size() >= 2 ? s.theta_edges.size() - 1 : 0;
   const size_t NR = s.r_edges.size() >= 2 ? s.r_edges.size() - 1 : 0;
-  const Layout L{s.plane_depths.size(), NA, NR};
+  const size_t TS = s.time_edges.empty() ? 0 : s.time_edges.size() + 1;
+  const Layout L{s.plane_depths.size(), NA, NR, TS, TS > 0 ? size_t(6) : size_t(0)};
   const Batches batches = trace_batches(s, L);
   auto estimate = [&](size_t j, double scale) { return batch_estimate(batches, s.photons, j, scale); };
   auto solid_angle = [&](size_t i) {
@@ -310,6 +389,14 @@ PhotonMcResult run_photon_mc(const PhotonMcSettings& s) {
     }
     for (size_t i = 0; i < NR; ++i) t.radial.push_back(estimate(L.radial(k) + i, 1.0 / area(i)));
     t.unscattered = estimate(L.unscattered(k), 1.0);
+    if (TS > 0) {
+      t.delay = time_tally(batches, s.photons, L.delay(k), TS);
+      t.delay_weight = estimate(L.moments(k), 1.0);
+      t.delay_mean = moment_statistic(batches, L.moments(k), delay_mean);
+      t.delay_variance = moment_statistic(batches, L.moments(k), delay_variance);
+      t.delay_mean_forward_only = moment_statistic(batches, L.moments(k) + 3, delay_mean);
+      t.delay_variance_forward_only = moment_statistic(batches, L.moments(k) + 3, delay_variance);
+    }
     r.planes.push_back(std::move(t));
   }
   r.specular = estimate(L.totals() + kSpecular, 1.0);
@@ -324,6 +411,10 @@ PhotonMcResult run_photon_mc(const PhotonMcSettings& s) {
   for (size_t i = 0; i < NR; ++i) {
     r.reflect_radial.push_back(estimate(L.reflect_radial() + i, 1.0 / area(i)));
     r.transmit_radial.push_back(estimate(L.transmit_radial() + i, 1.0 / area(i)));
+  }
+  if (TS > 0) {
+    r.reflect_time = time_tally(batches, s.photons, L.reflect_time(), TS);
+    r.transmit_time = time_tally(batches, s.photons, L.transmit_time(), TS);
   }
   return r;
 }

@@ -24,6 +24,11 @@
 //    unscattered light reflected at the bottom face), transmittance (everything leaving the bottom face,
 //    unscattered included) and unscattered transmittance apart, absorbed weight; exits also resolved in
 //    exit angle outside (weight per sr of exit solid angle, MCML's Rd_a / Tt_a) and radius (per area).
+// Time (issue 14; with time_edges): a photon's time is n times its path length in the medium (c = 1 in
+// vacuum).  Exits are binned by their time (reflect_time, transmit_time: weight per bin, per source
+// photon, not per unit time), and scattered forward crossings (cos theta > 0) of each plane z_k by their
+// delay n (s - z_k), with the weighted moments of that delay.  Every tallied event lands in exactly one
+// bin or in `before`/`after`, so the bins with those two sum to the steady tally of the same photons.
 // Determinism: photon i draws from Rng(seed, i), photons are grouped in batches (standard errors from
 // the spread of batch means) and batches are summed in order, so results do not depend on threads.
 #pragma once
@@ -47,12 +52,19 @@ struct PhotonMcSettings {
   std::vector<double> r_edges;      // [length], increasing, >= 0: plane radial bins and exit bins
   uint64_t photons = 100000;
   uint64_t seed = 1;
-  int batches = 16;  // >= 10 for standard errors
+  int batches = 16;                // >= 10 for standard errors
+  std::vector<double> time_edges;  // [length]; empty: no time tallies; else >= 2, increasing, >= 0
 };
 
 struct Estimate {
   double value = 0.0;
   double err = 0.0;  // standard error of the mean from batches
+};
+
+// Tallies binned in time (or delay): bins of time_edges, and the parts before the first and after the last.
+struct TimeTally {
+  std::vector<Estimate> bins;
+  Estimate before, after;
 };
 
 struct PlaneTally {
@@ -63,6 +75,13 @@ struct PlaneTally {
   // before the crossing, the light a small-angle model describes.
   std::vector<Estimate> angular_forward_only;
   Estimate unscattered;  // unscattered flux through the plane
+  // With time_edges: scattered forward crossings by delay n (s - z) (weight per bin), their total weight,
+  // and the weighted mean and variance of the delay (errors from the spread of batch values); the same
+  // moments of the photons that never travelled backward (the light a small-angle model describes: in an
+  // infinite medium rare photons that wander deep and return dominate the moments of all the light).
+  TimeTally delay;
+  Estimate delay_weight, delay_mean, delay_variance;
+  Estimate delay_mean_forward_only, delay_variance_forward_only;
 };
 
 struct PhotonMcResult {
@@ -70,6 +89,8 @@ struct PhotonMcResult {
   Estimate specular, diffuse_reflectance, transmittance, unscattered_transmittance, absorbed;
   // Exit-resolved slab tallies: exit polar angle outside (per sr) and exit radius (per area).
   std::vector<Estimate> reflect_angular, reflect_radial, transmit_angular, transmit_radial;
+  // With time_edges: diffuse reflectance and transmittance (unscattered included) by exit time.
+  TimeTally reflect_time, transmit_time;
 };
 
 // Throws nimbus::Error on invalid settings.  Multithreaded (oneTBB), deterministic for a seed.

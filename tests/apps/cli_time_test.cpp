@@ -1,0 +1,142 @@
+// `nimbus slab --time-edges` and `nimbus beam --time-edges` run as a user would: the CSV they promise,
+// rows that sum to the steady values, and exit code 2 naming the argument on bad time edges.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+struct CliRun {
+  int rc = -1;
+  std::string out;  // stdout and stderr together
+};
+
+CliRun run(const std::string& args) {
+  CliRun r;
+  const std::string cmd = std::string(NIMBUS_CLI) + " " + args + " 2>&1";
+  FILE* p = popen(cmd.c_str(), "r");
+  if (!p) return r;
+  char buf[4096];
+  size_t n;
+  while ((n = fread(buf, 1, sizeof buf, p)) > 0) r.out.append(buf, n);
+  const int status = pclose(p);
+  r.rc = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+std::filesystem::path temp_dir() {
+  auto d = std::filesystem::temp_directory_path() / ("nimbus_cli_time_test_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(d);
+  return d;
+}
+
+std::vector<std::string> split(const std::string& line) {
+  std::vector<std::string> v;
+  std::stringstream ss(line);
+  std::string item;
+  while (std::getline(ss, item, ',')) v.push_back(item);
+  return v;
+}
+
+TEST(CliTime, SlabWritesTimeRowsThatSumToTheSteadyValues) {
+  const auto dir = temp_dir();
+  const auto out = dir / "time.csv";
+  const CliRun r =
+      run("slab --mu-s 1 --mu-a 0.1 --g 0.5 --thickness 1 --n 1.4 --photons 4000 --time-edges 1:3:4 "
+          "--time-csv " +
+          out.string());
+  ASSERT_EQ(r.rc, 0) << r.out;
+  std::map<std::string, double> steady;
+  {
+    std::stringstream ss(r.out);
+    std::string name;
+    double value, err;
+    while (ss >> name >> value >> err) steady[name] = value;
+  }
+  std::ifstream in(out);
+  std::string line;
+  std::getline(in, line);
+  EXPECT_EQ(line, "tlo,thi,reflectance,reflectance_stderr,transmittance,transmittance_stderr");
+  std::vector<std::vector<std::string>> rows;
+  while (std::getline(in, line)) rows.push_back(split(line));
+  ASSERT_EQ(rows.size(), 6u);  // 0..1, four bins, 3..inf
+  EXPECT_EQ(std::stod(rows.front()[0]), 0.0);
+  EXPECT_EQ(std::stod(rows.front()[1]), 1.0);
+  EXPECT_TRUE(std::isinf(std::stod(rows.back()[1])));
+  double R = 0.0, T = 0.0;
+  for (const auto& row : rows) {
+    ASSERT_EQ(row.size(), 6u);
+    R += std::stod(row[2]);
+    T += std::stod(row[4]);
+  }
+  EXPECT_NEAR(R, steady["diffuse_reflectance"], 1e-6);
+  EXPECT_NEAR(T, steady["transmittance"], 1e-6);
+  // Causality: no transmission before n D = 1.4 (the row 0..1 and the bin 1..1.5 hold the unscattered
+  // light at 1.4 and nothing earlier than 1).
+  EXPECT_EQ(std::stod(rows[0][4]), 0.0);
+  EXPECT_GE(std::stod(rows[1][4]), steady["unscattered_transmittance"] - 1e-7);
+}
+
+TEST(CliTime, BeamAddsDelayRowsForMcAndMfs) {
+  const CliRun r =
+      run("beam --phase gauss:0.01 --albedo 0.99 --depths 0.5,1 --photons 2000 --models mc,mfs "
+          "--theta-edges 0,0.1,3.14159 --r-edges 0,1 --time-edges 0,0.001,0.01");
+  ASSERT_EQ(r.rc, 0) << r.out;
+  std::map<std::string, int> count;
+  std::stringstream ss(r.out);
+  std::string line;
+  while (std::getline(ss, line)) {
+    const auto v = split(line);
+    if (v.size() == 7 && v[2].rfind("delay", 0) == 0) ++count[v[0] + ":" + v[2]];
+  }
+  for (const char* m : {"mc", "mfs"}) {
+    EXPECT_EQ(count[std::string(m) + ":delay"], 2 * 3) << m;  // two bins and the tail, per depth
+    EXPECT_EQ(count[std::string(m) + ":delay_mean"], 2) << m;
+    EXPECT_EQ(count[std::string(m) + ":delay_variance"], 2) << m;
+  }
+}
+
+const char* const kBadEdges[] = {"''", "2,1", "-1,1", "0:1:1e9", "5"};
+
+TEST(CliTime, SlabBadTimeEdgesExitWithCode2NamingTheArgument) {
+  const auto dir = temp_dir();
+  const auto out = dir / "never.csv";
+  const std::string slab =
+      "slab --mu-s 1 --mu-a 0 --g 0 --thickness 1 --photons 100 --time-csv " + out.string();
+  for (const char* bad : kBadEdges) {
+    const CliRun r = run(slab + " --time-edges=" + bad);
+    EXPECT_EQ(r.rc, 2) << bad << ": " << r.out;
+    EXPECT_NE(r.out.find("--time-edges"), std::string::npos) << bad << ": " << r.out;
+  }
+  const CliRun r = run(slab);  // --time-csv without --time-edges
+  EXPECT_EQ(r.rc, 2) << r.out;
+  EXPECT_FALSE(std::filesystem::exists(out));
+  std::filesystem::remove_all(dir);
+}
+
+TEST(CliTime, BeamBadTimeEdgesExitWithCode2NamingTheArgument) {
+  const std::string beam = "beam --phase hg:0.9 --albedo 0.9 --photons 100 --depths 1 --time-edges=";
+  for (const char* bad : kBadEdges) {
+    const CliRun b = run(beam + bad);
+    EXPECT_EQ(b.rc, 2) << bad << ": " << b.out;
+    EXPECT_NE(b.out.find("--time-edges"), std::string::npos) << bad << ": " << b.out;
+  }
+  // More bins x depths than the tallies may hold.
+  std::string depths = "0.1";
+  for (int i = 2; i <= 100; ++i) depths += "," + std::to_string(0.1 * i);
+  const CliRun m =
+      run("beam --phase hg:0.9 --albedo 0.9 --photons 100 --time-edges 0:1:100000 --depths " + depths);
+  EXPECT_EQ(m.rc, 2) << m.out;
+  EXPECT_NE(m.out.find("--time-edges"), std::string::npos) << m.out;
+}
+
+}  // namespace
