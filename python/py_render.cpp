@@ -135,9 +135,12 @@ py::dict render_py(const py::object& scene_obj, std::optional<int> spp, int thre
   options.threads = threads;
   options.time_limit = time_limit.value_or(0.0);
   options.cancel = &run.cancel;
+  // Called from worker threads, possibly out of order: keep the largest count.
   options.progress = [&run](int64_t done, int64_t total, int64_t) {
     run.total.store(total);
-    run.done.store(done);
+    int64_t seen = run.done.load();
+    while (done > seen && !run.done.compare_exchange_weak(seen, done)) {
+    }
   };
   std::thread worker([&run, &options, scene] {
     try {

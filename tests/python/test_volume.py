@@ -45,8 +45,8 @@ class NumpyVolume(unittest.TestCase):
         vol = nimbus.Volume(d, voxel_size=0.15, origin=(-1.0, -0.9, -1.1), name="blob")
         self.assertEqual(vol.active_voxels, int(np.count_nonzero(d)))
         self.assertAlmostEqual(vol.max, float(d.max()), places=6)
-        self.assertEqual(vol.voxel_size, (0.15, 0.15, 0.15))
-        self.assertEqual(vol.origin, (-1.0, -0.9, -1.1))
+        self.assertEqual(vol.voxel_size, [0.15, 0.15, 0.15])
+        self.assertEqual(vol.origin, [-1.0, -0.9, -1.1])
         path = os.path.join(self.dir, "blob.vdb")
         vol.save(path)
         for integrator in ("pathtrace", "mfs"):
@@ -68,16 +68,18 @@ class NumpyVolume(unittest.TestCase):
         self.assertEqual(a.dtype, np.float32)
         self.assertEqual(a.shape, tuple(hi - lo + 1 for lo, hi in zip(v.index_min, v.index_max)))
         self.assertAlmostEqual(float(a.max()), v.max, places=6)
-        again = nimbus.Volume(a, v.voxel_size, v.origin, v.index_min)
+        again = nimbus.Volume(a, v.voxel_size, v.origin, v.index_min, active=v.active_mask())
         self.assertEqual((again.index_min, again.index_max), (v.index_min, v.index_max))
+        self.assertEqual((again.voxel_size, again.origin), (v.voxel_size, v.origin))
+        self.assertTrue(np.array_equal(again.active_mask(), v.active_mask()))
         self.assertTrue(np.array_equal(again.to_numpy(), a))
 
     def test_the_disney_cloud_from_numpy_equals_the_file(self):
         """The cloud's voxels through numpy and back: the same grid, the same image."""
         path = os.path.join(SOURCE_DIR, "data", "volumes", "wdas_cloud_sixteenth.vdb")
         v = nimbus.Volume.from_file(path, "density")
-        again = nimbus.Volume(v.to_numpy(), v.voxel_size, v.origin, v.index_min)
-        self.assertEqual(again.active_voxels, v.active_voxels)
+        again = nimbus.Volume(v.to_numpy(), v.voxel_size, v.origin, v.index_min, active=v.active_mask())
+        self.assertEqual(again.active_voxels, v.active_voxels)  # the file keeps some zeros active
         lo, hi = v.bounds
         centre = [(a + b) / 2 for a, b in zip(lo, hi)]
         doc = {"camera": {"position": [centre[0], centre[1] - 900, centre[2]], "look_at": centre,
