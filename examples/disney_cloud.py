@@ -36,11 +36,20 @@ def main():
     p.add_argument("--size", type=int, default=160, help="image width [pixels]; height keeps the aspect")
     p.add_argument("--spp", type=int, default=64, help="pathtrace samples per pixel")
     p.add_argument("--mfs-spp", type=int, default=16)
+    p.add_argument("--mfs-photons", type=int, default=None, help="mfs scatter grid photons (default: mfs's)")
+    p.add_argument("--mfs-grid", type=int, default=None, help="mfs scatter grid resolution (default: auto)")
     args = p.parse_args()
     scene = nimbus.load_scene(args.scene)
     height = max(1, round(args.size * scene.height / scene.width))
-    scene = nimbus.load_scene(args.scene, overrides={"camera.width": args.size, "camera.height": height})
-    mfs = nimbus.render(scene, integrator="mfs", spp=args.mfs_spp)
+    size = {"camera.width": args.size, "camera.height": height}
+    scene = nimbus.load_scene(args.scene, overrides=size)
+    # mfs's own settings belong in an mfs integrator block.
+    mfs_settings = {"integrator.type": "mfs", "integrator.spp": args.mfs_spp}
+    if args.mfs_photons:
+        mfs_settings["integrator.photons"] = args.mfs_photons
+    if args.mfs_grid:
+        mfs_settings["integrator.scatter_grid_resolution"] = args.mfs_grid
+    mfs = nimbus.render(nimbus.load_scene(args.scene, overrides={**size, **mfs_settings}))
     ref = nimbus.render(scene, integrator="pathtrace", spp=args.spp)
     c = compare(mfs["rgba"], ref["rgba"])
     print(f"mfs       {mfs['spp']:5d} spp {mfs['seconds']:7.2f} s  mean {c['mean_mfs']:.5f}")

@@ -49,7 +49,7 @@ class NumpyVolume(unittest.TestCase):
         self.assertEqual(vol.origin, [-1.0, -0.9, -1.1])
         path = os.path.join(self.dir, "blob.vdb")
         vol.save(path)
-        for integrator in ("pathtrace", "mfs"):
+        for integrator in ("pathtrace", "single"):
             with self.subTest(integrator=integrator):
                 from_file = self.cli_render(scene_with({"type": "vdb", "file": path, "scale": 1.2}, integrator))
                 doc = scene_with({"type": "vdb", "volume": vol, "scale": 1.2}, integrator)
