@@ -184,6 +184,25 @@ class ProgressAndInterrupt(unittest.TestCase):
         # The module still works afterwards.
         self.assertEqual(nimbus.render(small_scene(spp=1))["spp"], 1)
 
+    def test_the_gil_is_released(self):
+        """Python threads run while a render runs (with the GIL held they would wait for it)."""
+        done = threading.Event()
+        result = {}
+
+        def work():
+            result["r"] = nimbus.render(small_scene(spp=1 << 20, width=32, height=32), time_limit=1.0)
+            done.set()
+
+        t = threading.Thread(target=work)
+        t.start()
+        ticks = 0
+        while not done.is_set():
+            ticks += 1
+            time.sleep(0.01)
+        t.join()
+        self.assertGreater(ticks, 20)
+        self.assertTrue(result["r"]["time_limited"])
+
     def test_time_limit(self):
         r = nimbus.render(small_scene(spp=1 << 20, width=32, height=32), time_limit=0.5)
         self.assertTrue(r["time_limited"])
