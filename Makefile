@@ -2,7 +2,8 @@
 #   make demo   installs missing Debian packages, builds, renders the built-in scene with mfs to
 #               out/demo.{exr,png} and with pathtrace in the same time to out/demo_pathtrace.{exr,png}
 #   make test   installs missing Debian packages, builds, runs the whole suite through ctest
-# Also: make (build only), make test-fast (no statistical tests), make asan (sanitizer build + fast tests),
+# Also: make (build only), make python (the Python module in build/python/: docs/python.md),
+# make test-fast (no statistical tests), make asan (sanitizer build + fast tests),
 # make fuzz-smoke (libFuzzer targets, 60 s each), make fuzz FUZZ_SECONDS=N (N s each): docs/reliability.md.
 BUILD ?= build
 JOBS ?= $(shell nproc)
@@ -12,7 +13,7 @@ FUZZ_SECONDS ?= 600
 # the ones the other fast tests already take there.
 ASAN_SKIP ?= ^Stress\.ExtremeScenesHaveNoNonFiniteSamples$$|^Determinism\.EveryIntegratorIsBitIdenticalForAnyThreadCount$$
 
-.PHONY: all deps configure build demo test test-fast asan bench clean fuzz-build fuzz-smoke fuzz fuzz-seeds
+.PHONY: all deps configure build python demo test test-fast asan bench clean fuzz-build fuzz-smoke fuzz fuzz-seeds
 
 all: build
 
@@ -26,6 +27,10 @@ configure: $(BUILD)/build.ninja
 
 build: configure
 	cmake --build $(BUILD) -j $(JOBS)
+
+python: configure
+	cmake --build $(BUILD) -j $(JOBS) --target nimbus_python
+	@echo "nimbus: PYTHONPATH=$(abspath $(BUILD))/python /usr/bin/python3 -c 'import nimbus'"
 
 demo: deps
 	@$(MAKE) --no-print-directory build

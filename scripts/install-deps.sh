@@ -12,7 +12,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libembree-dev libtinyobjloader-dev
   clang-14 libclang-rt-14-dev
-  python3 python3-numpy python3-matplotlib
+  python3 python3-numpy python3-matplotlib python3-dev pybind11-dev python3-pybind11
 )
 
 missing=()

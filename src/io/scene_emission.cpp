@@ -43,7 +43,8 @@ void parse_medium_emission(JsonObject& o, Medium& m, const std::filesystem::path
   const char* first = !e.emission_grid.empty() ? "emission_grid"
                       : blackbody              ? "temperature_grid"
                                                : "color_grid";
-  if (!v) o.fail(first, "grids are read from a vdb shape's file; this medium's shape has none");
+  if (!v || v->file.empty())
+    o.fail(first, "grids are read from a vdb shape's file; this medium's shape has none");
   const std::filesystem::path file = resolve_scene_path(base_dir, v->file);
   auto grids = std::make_shared<EmissionGrids>();
   if (!e.emission_grid.empty()) {

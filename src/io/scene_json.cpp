@@ -53,7 +53,7 @@ Phase parse_phase(JsonObject o) {
   return phase;
 }
 
-Shape parse_shape(JsonObject o, const std::filesystem::path& base_dir) {
+Shape parse_shape(JsonObject o, const std::filesystem::path& base_dir, const VolumeTable& volumes) {
   const std::string type = o.string("type");
   Shape shape;
   if (type == "sphere") {
@@ -67,11 +67,29 @@ Shape parse_shape(JsonObject o, const std::filesystem::path& base_dir) {
     shape = b;
   } else if (type == "vdb") {
     VdbShape v;
-    v.file = o.string("file");
+    const bool in_memory = o.has("volume");  // a `file`, or else an in-memory `volume`
+    std::string volume;
+    if (in_memory) {
+      volume = o.string("volume");
+      if (volume.empty()) o.fail("volume", "must name an in-memory volume");
+      if (o.has("file")) o.fail("volume", "give either a file or a volume, not both");
+    } else {
+      v.file = o.string("file");
+    }
     v.grid = o.string("grid", "");
     v.translate = o.vec3("translate", v.translate);
     v.scale = o.number_open_below("scale", 0.0, 1e30, v.scale);
-    load_vdb_shape(v, base_dir, o.where(), o.path());
+    if (!in_memory) {
+      load_vdb_shape(v, base_dir, o.where(), o.path());
+    } else {
+      if (o.has("grid")) o.fail("grid", "an in-memory volume has one grid; name none");
+      const auto it = volumes.find(volume);
+      if (it == volumes.end())
+        o.fail("volume", fmt::format("no in-memory volume named '{}' (in-memory volumes come from the "
+                                     "Python module: docs/python.md; a scene file names a `file`)",
+                                     volume));
+      v.data = it->second;
+    }
     shape = v;
   } else if (type == "cloud") {
     CloudShape c;
@@ -88,9 +106,9 @@ Shape parse_shape(JsonObject o, const std::filesystem::path& base_dir) {
   return shape;
 }
 
-Medium parse_medium(JsonObject o, const std::filesystem::path& base_dir) {
+Medium parse_medium(JsonObject o, const std::filesystem::path& base_dir, const VolumeTable& volumes) {
   Medium m;
-  m.shape = parse_shape(o.object("shape"), base_dir);
+  m.shape = parse_shape(o.object("shape"), base_dir, volumes);
   m.transform = parse_optional_transform(o);
   m.sigma_s = o.rgb("sigma_s", 0.0);
   m.sigma_a = o.rgb("sigma_a", 0.0, Rgb(0.0));
@@ -162,6 +180,11 @@ FilmSettings parse_film(JsonObject o) {
 }  // namespace
 
 Scene parse_scene(const nlohmann::json& doc, const std::string& name, const std::filesystem::path& base_dir) {
+  return parse_scene(doc, name, base_dir, VolumeTable{});
+}
+
+Scene parse_scene(const nlohmann::json& doc, const std::string& name, const std::filesystem::path& base_dir,
+                  const VolumeTable& volumes) {
   JsonObject root(doc, name, "");
   Scene scene;
   scene.camera = parse_camera(root.object("camera"));
@@ -169,7 +192,7 @@ Scene parse_scene(const nlohmann::json& doc, const std::string& name, const std:
   // Checked before any volume is loaded or voxelised (the renderer would refuse the scene anyway).
   if (media.size() > size_t(kMaxMedia))
     root.fail("media", fmt::format("at most {} media (got {})", kMaxMedia, media.size()));
-  for (JsonObject& m : media) scene.media.push_back(parse_medium(m, base_dir));
+  for (JsonObject& m : media) scene.media.push_back(parse_medium(m, base_dir, volumes));
   if (root.has("surfaces"))
     for (JsonObject& s : root.array_of_objects("surfaces", true))
       scene.surfaces.push_back(parse_surface(s, base_dir));

@@ -2,6 +2,8 @@
 #pragma once
 
 #include <filesystem>
+#include <map>
+#include <memory>
 #include <string>
 
 #include "nimbus/scene.h"
@@ -14,5 +16,12 @@ void load_vdb_shape(VdbShape& v, const std::filesystem::path& base_dir, const st
                     const std::string& json_path);
 // Voxelises the procedural cloud into c.data.
 void build_cloud_shape(CloudShape& c);
+
+// In-memory density grids by name (the Python module's numpy volumes, docs/python.md): a vdb shape that
+// says "volume": NAME instead of "file" takes the grid of that name.
+using VolumeTable = std::map<std::string, std::shared_ptr<const DensityGrid>>;
+// parse_scene (nimbus/scene.h) with in-memory volumes; without them a `volume` field is an error.
+Scene parse_scene(const nlohmann::json& doc, const std::string& name, const std::filesystem::path& base_dir,
+                  const VolumeTable& volumes);
 
 }  // namespace nimbus

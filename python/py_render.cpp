@@ -1,0 +1,202 @@
+// nimbus.render (docs/python.md, "Rendering"): the render runs on its own thread with the GIL released;
+// the calling thread waits for it, and every 50 ms takes the GIL to check for signals (Ctrl-C) and to
+// hand the latest progress to the Python callback. A KeyboardInterrupt, or an exception raised by the
+// callback, sets the render's cancel flag: the render stops within a tile and the exception propagates.
+#include <fmt/format.h>
+#include <pybind11/stl.h>
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <exception>
+#include <map>
+#include <mutex>
+#include <optional>
+#include <thread>
+
+#include "nimbus/error.h"
+#include "nimbus/render.h"
+#include "py_common.h"
+
+namespace nimbus::python {
+
+namespace {
+
+// What the render thread shares with the waiting one.
+struct RenderRun {
+  std::mutex mutex;
+  std::condition_variable finished_cv;
+  bool finished = false;
+  std::atomic<bool> cancel{false};
+  std::atomic<int64_t> done{-1}, total{0};
+  RenderResult result;
+  std::exception_ptr error;
+};
+
+// The layer a film channel belongs to: "Z" is depth, "direct.R" is direct.
+std::string layer_of(const std::string& channel) {
+  if (channel == "Z") return "depth";
+  const size_t dot = channel.find('.');
+  return dot == std::string::npos ? channel : channel.substr(0, dot);
+}
+
+// The image's RGBA (alpha 1 where the image has none) as H x W x 4.
+py::array_t<float> rgba_array(const Image& img) {
+  const size_t n = size_t(img.width) * img.height;
+  std::vector<float> rgba(n * 4);
+  for (size_t i = 0; i < n; ++i) {
+    for (int c = 0; c < 3; ++c) rgba[i * 4 + c] = img.rgb[i * 3 + c];
+    rgba[i * 4 + 3] = img.alpha.empty() ? 1.0f : img.alpha[i];
+  }
+  return float_array(rgba, {img.height, img.width, 4});
+}
+
+// The film's layers: one-channel layers as H x W, the others as H x W x C (channels in film order).
+py::dict layer_arrays(const Image& img) {
+  std::map<std::string, std::vector<const ImageChannel*>> layers;
+  std::vector<std::string> order;
+  for (const ImageChannel& c : img.channels) {
+    const std::string name = layer_of(c.name);
+    if (!layers.count(name)) order.push_back(name);
+    layers[name].push_back(&c);
+  }
+  py::dict out;
+  const size_t n = size_t(img.width) * img.height;
+  for (const std::string& name : order) {
+    const auto& channels = layers[name];
+    const size_t k = channels.size();
+    std::vector<float> data(n * k);
+    for (size_t i = 0; i < n; ++i)
+      for (size_t c = 0; c < k; ++c) data[i * k + c] = channels[c]->data[i];
+    out[py::str(name)] = k == 1 ? float_array(data, {img.height, img.width})
+                                : float_array(data, {img.height, img.width, py::ssize_t(k)});
+  }
+  return out;
+}
+
+py::dict result_dict(const RenderResult& r) {
+  py::dict d;
+  d["rgba"] = rgba_array(r.image);
+  d["layers"] = layer_arrays(r.image);
+  d["width"] = r.image.width;
+  d["height"] = r.image.height;
+  d["integrator"] = r.integrator;
+  d["spp"] = r.spp;
+  d["spp_requested"] = r.spp_requested;
+  d["seed"] = r.seed;
+  d["seconds"] = r.seconds;
+  d["time_limited"] = r.time_limited;
+  d["nonfinite_samples"] = r.nonfinite_samples;
+  d["settings"] = from_json(r.settings);
+  py::dict meta;
+  for (const auto& [k, v] : r.metadata) meta[py::str(k)] = v;
+  d["metadata"] = meta;
+  return d;
+}
+
+// Waits for the render thread; with the GIL every 50 ms: signals, then the progress callback. Returns the
+// Python exception that stopped the render, if any (the render is then cancelled and awaited).
+std::optional<py::error_already_set> wait_for_render(RenderRun& run, const py::object& progress) {
+  std::optional<py::error_already_set> raised;
+  int64_t reported = -1;
+  for (bool finished = false; !finished;) {
+    {
+      py::gil_scoped_release release;
+      std::unique_lock<std::mutex> lock(run.mutex);
+      finished = run.finished_cv.wait_for(lock, std::chrono::milliseconds(50), [&] { return run.finished; });
+    }
+    if (raised) continue;  // cancelled: wait for the render to drop its pass
+    try {
+      if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+      const int64_t done = run.done.load();
+      if (!progress.is_none() && done > reported && (done >= 0 || finished)) {
+        reported = done;
+        progress(done, run.total.load());
+      }
+    } catch (py::error_already_set& e) {
+      raised.emplace(std::move(e));
+      run.cancel.store(true);
+    }
+  }
+  return raised;
+}
+
+py::dict render_py(const py::object& scene_obj, std::optional<int> spp, int threads,
+                   std::optional<std::string> integrator, std::optional<uint64_t> seed,
+                   std::optional<std::vector<std::string>> layers, const py::object& progress,
+                   std::optional<double> time_limit) {
+  const std::shared_ptr<Scene> scene = as_scene(scene_obj);
+  RenderRun run;
+  RenderOptions options;
+  options.spp = spp;
+  options.seed = seed;
+  options.integrator = integrator;
+  options.layers = layers;
+  options.threads = threads;
+  options.time_limit = time_limit.value_or(0.0);
+  options.cancel = &run.cancel;
+  // Called from worker threads, possibly out of order: keep the largest count.
+  options.progress = [&run](int64_t done, int64_t total, int64_t) {
+    run.total.store(total);
+    int64_t seen = run.done.load();
+    while (done > seen && !run.done.compare_exchange_weak(seen, done)) {
+    }
+  };
+  std::thread worker([&run, &options, scene] {
+    try {
+      run.result = render(*scene, options);
+    } catch (...) {
+      run.error = std::current_exception();
+    }
+    std::lock_guard<std::mutex> lock(run.mutex);
+    run.finished = true;
+    run.finished_cv.notify_all();
+  });
+  std::optional<py::error_already_set> raised;
+  try {
+    raised = wait_for_render(run, progress);
+  } catch (...) {
+    run.cancel.store(true);
+    py::gil_scoped_release release;
+    worker.join();
+    throw;
+  }
+  {
+    py::gil_scoped_release release;
+    worker.join();
+  }
+  if (raised) throw std::move(*raised);
+  if (run.error) std::rethrow_exception(run.error);
+  if (run.result.partial) throw Cancelled();
+  return result_dict(run.result);
+}
+
+}  // namespace
+
+void init_render(py::module_& m) {
+  m.def("render", &render_py, py::arg("scene"), py::arg("spp") = py::none(), py::arg("threads") = 0,
+        py::arg("integrator") = py::none(), py::arg("seed") = py::none(), py::arg("layers") = py::none(),
+        py::arg("progress") = py::none(), py::arg("time_limit") = py::none(),
+        R"(Renders a scene: a nimbus.Scene, a dict (scene_from_dict) or a path (load_scene).
+
+spp, integrator, seed: override the scene's integrator block (another integrator than the scene's
+  starts from its own defaults, as `nimbus render --integrator` does).
+threads: worker threads, 0 = all cores (the image is the same for any count).
+layers: compositing layers to keep besides RGBA, e.g. ['depth', 'direct'] (names: nimbus.layer_names()).
+progress: called as progress(done, total) with the pixel samples taken and to take, from the calling
+  thread, at most every 50 ms and once at the end.
+time_limit: a budget in seconds; the render takes whole passes (1, 2, 4, ... spp) while they fit.
+
+The GIL is released while rendering. Ctrl-C (KeyboardInterrupt), or an exception raised by the
+progress callback, stops the render within a tile and propagates.
+
+Returns a dict: 'rgba' float32 H x W x 4 (linear, premultiplied alpha, row 0 the top), 'layers'
+{name: float32 H x W (depth [world units], samples) or H x W x 3}, and the resolved settings:
+'width', 'height', 'integrator', 'spp' (reached), 'spp_requested', 'seed', 'seconds' (wall time),
+'time_limited', 'nonfinite_samples', 'settings' (the integrator block as rendered, auto choices
+resolved), 'metadata' (what an EXR header would carry).)");
+  m.def("integrator_names", &integrator_names, "Names of the integrators.");
+  m.def("layer_names", &film_layer_names, "Names of the compositing layers a render can keep.");
+}
+
+}  // namespace nimbus::python
