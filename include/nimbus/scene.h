@@ -162,9 +162,17 @@ struct Surface {
   Transform transform;  // applied after the shape's own fields: world = transform * shape
 };
 
+// The spp an integrator renders with when the scene and the command line give none: the one with the
+// best error per second. pathtrace's error falls as 1 / sqrt(spp) at a cost in proportion to spp (any
+// spp has the same efficiency; 64 is a first look); the deterministic marches' error is mostly their
+// bias, which more samples do not reduce: 4 spp (anti-aliasing and the march's jitter) is where their
+// error stops falling on the validation suite (docs/validation/render.md).
+inline int default_spp(const std::string& integrator) { return integrator == "pathtrace" ? 64 : 4; }
+
 struct IntegratorSettings {
   std::string type = "pathtrace";
   int spp = 64;
+  bool spp_given = false;  // the scene names its spp (else default_spp(type))
   int max_events = 0;  // most scattering events on a path; 0 = unlimited
   uint64_t seed = 1;
   // The integrator's own fields as written (checked by the scene parser through the registry; each

@@ -140,7 +140,8 @@ Camera parse_camera(JsonObject o) {
 IntegratorSettings parse_integrator(const nlohmann::json& j, JsonObject o) {
   IntegratorSettings s;
   s.type = o.string("type", s.type);
-  s.spp = int(o.integer("spp", 1, kMaxSpp, s.spp));
+  s.spp_given = j.contains("spp");
+  s.spp = int(o.integer("spp", 1, kMaxSpp, default_spp(s.type)));
   s.max_events = int(o.integer("max_events", 0, 1000000, s.max_events));
   s.seed = uint64_t(o.integer("seed", 0, int64_t(1) << 53, int64_t(s.seed)));
   const std::vector<std::string> known = integrator_names();

@@ -42,6 +42,7 @@ IntegratorSettings resolve_settings(const Scene& scene, const RenderOptions& opt
     find_integrator(*options.integrator);  // an unknown name is an error naming the known ones
     settings.type = *options.integrator;
     settings.options = nlohmann::json::object();
+    if (!settings.spp_given && !options.spp) settings.spp = default_spp(settings.type);
   }
   if (settings.spp < 1 || settings.spp > kMaxSpp)
     throw Error(fmt::format("spp must be between 1 and {}", kMaxSpp));
