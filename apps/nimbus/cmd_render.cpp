@@ -14,6 +14,7 @@
 #include "nimbus/render.h"
 #include "nimbus/scene.h"
 #include "progress.h"
+#include "ranges.h"
 
 namespace nimbus::cli {
 
@@ -44,6 +45,8 @@ struct RenderArgs {
   std::string resume;             // --resume: the EXR to continue
   std::vector<std::string> sets;  // --set PATH=VALUE
   std::string res;                // --res WxH
+  std::string region;             // --region x0,y0,x1,y1
+  std::string samples;            // --samples START:COUNT
   bool quiet = false;
 };
 
@@ -84,17 +87,30 @@ std::string meta_value(const ImageMetadata& meta, const std::string& key, const 
   throw Error(fmt::format("{}: no {} in the header (not a nimbus render?)", file, key));
 }
 
+// The region and sample range a resumed render had (absent in files from before them: none).
+void resume_window(const ImageMetadata& meta, const std::string& file, RenderOptions* options) {
+  for (const auto& [k, v] : meta) {
+    if (k == "nimbus/region") options->region = parse_region(v, file + ": nimbus/region");
+    if (k == "nimbus/sample_start") {
+      char extra = 0;
+      if (std::sscanf(v.c_str(), "%d%c", &options->sample_start, &extra) != 1 || options->sample_start < 0)
+        throw Error(fmt::format("{}: nimbus/sample_start '{}' is not a sample index", file, v));
+    }
+  }
+}
+
 // --resume FILE: the scene, spp and film state of a nimbus EXR. The render goes on to args.spp, or to
 // the spp the file asked for.
-Scene resume_scene(const RenderArgs& args, FilmState* state, std::optional<int>* spp) {
+Scene resume_scene(const RenderArgs& args, FilmState* state, RenderOptions* options) {
+  std::optional<int>* spp = &options->spp;
   if (!args.scene.empty())
     throw Error(
         fmt::format("--resume: {}: the scene comes from the EXR's header; give no scene file", args.scene));
   if (args.integrator || args.seed || args.layers_given || !args.deep.empty() || !args.sets.empty() ||
-      !args.res.empty())
+      !args.res.empty() || !args.region.empty() || !args.samples.empty())
     throw Error(
-        "--resume: --integrator, --seed, --layers, --deep, --set and --res must be those of the resumed "
-        "render");
+        "--resume: --integrator, --seed, --layers, --deep, --set, --res, --region and --samples must be "
+        "those of the resumed render");
   ImageMetadata meta;
   read_exr(args.resume, &meta);
   *state = read_exr_state(args.resume);
@@ -107,6 +123,7 @@ Scene resume_scene(const RenderArgs& args, FilmState* state, std::optional<int>*
   }
   Scene scene = parse_scene(doc, args.resume + " (nimbus/scene)", file.parent_path());
   scene.file = file;
+  resume_window(meta, args.resume, options);
   const int requested = scene.integrator.spp;
   *spp = args.spp ? *args.spp : requested;
   if (**spp <= state->spp)
@@ -148,6 +165,17 @@ Scene load_render_scene(const RenderArgs& args) {
   return parse_scene(doc, "(built-in demo)", ".");
 }
 
+// --region against the scene's image size (the library checks again, without the option's name).
+void check_region(const RenderArgs& args, const Scene& scene, const RenderOptions& options) {
+  const Region& r = *options.region;
+  const int w = scene.camera.width, h = scene.camera.height;
+  if (!(0 <= r.x0 && r.x0 < r.x1 && r.x1 <= w && 0 <= r.y0 && r.y0 < r.y1 && r.y1 <= h))
+    throw Error(fmt::format(
+        "--region {}: not a window inside the {}x{} image (x0,y0,x1,y1 in pixels, half-open: 0 <= x0 < "
+        "x1 <= {}, 0 <= y0 < y1 <= {})",
+        args.region, w, h, w, h));
+}
+
 int run_render(RenderArgs args) {
   if (!args.resume.empty() && args.output.empty()) args.output = args.resume;
   if (args.output.empty()) throw Error("--output is required");
@@ -157,12 +185,23 @@ int run_render(RenderArgs args) {
   FilmState state;
   std::optional<Scene> resumed;
   if (!args.resume.empty()) {
-    resumed.emplace(resume_scene(args, &state, &options.spp));
+    resumed.emplace(resume_scene(args, &state, &options));
     options.resume = &state;
   } else {
     options.spp = args.spp;
+    if (!args.region.empty()) options.region = parse_region(args.region, "--region");
+    if (!args.samples.empty()) {
+      if (args.spp) throw Error("--samples START:COUNT sets the spp (COUNT): give no --spp");
+      const auto [start, count] = parse_samples(args.samples);
+      options.sample_start = start;
+      options.spp = count;
+    }
+    if ((options.region || options.sample_start > 0) && !args.deep.empty())
+      throw Error(
+          "--deep: a deep image is made of the whole image and all its samples (no --region, --samples)");
   }
   const Scene scene = resumed ? std::move(*resumed) : load_render_scene(args);
+  if (options.region && args.resume.empty()) check_region(args, scene, options);
   options.seed = args.seed;
   options.integrator = args.integrator;
   if (args.layers_given) options.layers = args.layers;
@@ -254,6 +293,12 @@ void add_render_command(CLI::App& app, Action& action) {
   cmd->add_option("--resume", args->resume,
                   "Continue this EXR (a partial or finished nimbus render) to more samples (--spp, default "
                   "the spp it asked for); the scene comes from its header. Bit-identical to one render");
+  cmd->add_option("--region", args->region,
+                  "Render only the crop window x0,y0,x1,y1 (pixels of the full image, row 0 at the top, "
+                  "half-open: x0 <= x < x1); the EXR keeps the full display window, the crop as data window");
+  cmd->add_option("--samples", args->samples,
+                  "Take sample indices START..START+COUNT-1 of every pixel (START:COUNT, instead of --spp): "
+                  "renders of disjoint ranges combine with `nimbus merge`");
   cmd->add_flag("-q,--quiet", args->quiet, "No progress bar or summary");
   cmd->callback([args, &action] { action = [args] { return run_render(*args); }; });
 }
