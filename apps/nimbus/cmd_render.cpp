@@ -9,6 +9,7 @@
 #include <optional>
 
 #include "commands.h"
+#include "frames.h"
 #include "nimbus/error.h"
 #include "nimbus/image.h"
 #include "nimbus/render.h"
@@ -41,12 +42,14 @@ struct RenderArgs {
   int deep_samples = 32;
   int threads = 0;
   double exposure = 0.0;
-  double time_limit = 0.0;        // --time: seconds, 0 = none
-  std::string resume;             // --resume: the EXR to continue
-  std::vector<std::string> sets;  // --set PATH=VALUE
-  std::string res;                // --res WxH
-  std::string region;             // --region x0,y0,x1,y1
-  std::string samples;            // --samples START:COUNT
+  double time_limit = 0.0;            // --time: seconds, 0 = none
+  std::string resume;                 // --resume: the EXR to continue
+  std::vector<std::string> sets;      // --set PATH=VALUE
+  std::string res;                    // --res WxH
+  std::string region;                 // --region x0,y0,x1,y1
+  std::string samples;                // --samples START:COUNT
+  std::optional<std::string> frames;  // --frames LIST: a sequence, $F / $F4 in file names
+  std::optional<int> frame;           // the frame this run renders (one of --frames)
   bool quiet = false;
 };
 
@@ -158,11 +161,18 @@ std::vector<std::string> scene_overrides(const RenderArgs& args) {
 
 Scene load_render_scene(const RenderArgs& args) {
   const std::vector<std::string> sets = scene_overrides(args);
-  if (!args.scene.empty()) return load_scene(args.scene, sets);
-  if (sets.empty()) return builtin_demo_scene();
-  nlohmann::json doc = builtin_demo_document();
+  if (!args.frame) {
+    if (!args.scene.empty()) return load_scene(args.scene, sets);
+    if (sets.empty()) return builtin_demo_scene();
+  }
+  // The document, its overrides, then (a frame of a sequence) $F in every string: file names and all.
+  nlohmann::json doc = args.scene.empty() ? builtin_demo_document() : read_scene_document(args.scene);
   for (const std::string& o : sets) apply_scene_override(doc, o);
-  return parse_scene(doc, "(built-in demo)", ".");
+  if (args.frame) substitute_frame(doc, *args.frame);
+  if (args.scene.empty()) return parse_scene(doc, "(built-in demo)", ".");
+  Scene scene = parse_scene(doc, args.scene, std::filesystem::path(args.scene).parent_path());
+  scene.file = args.scene;
+  return scene;
 }
 
 // --region against the scene's image size (the library checks again, without the option's name).
@@ -176,7 +186,37 @@ void check_region(const RenderArgs& args, const Scene& scene, const RenderOption
         args.region, w, h, w, h));
 }
 
+int run_render(RenderArgs args);
+
+// --frames: the frames one after another, $F in the scene's strings and the output names. Stops at the
+// first frame that fails (a bad scene exits 2 naming it, an interrupted frame 1).
+int run_frames(const RenderArgs& args) {
+  const std::vector<int> frames = parse_frames(*args.frames);
+  if (!args.resume.empty()) throw Error("--frames: not with --resume (resume each frame's file)");
+  if (!has_frame_token(args.output))
+    throw Error(fmt::format(
+        "--frames: the output '{}' holds no frame number: write $F or $F4 in it (e.g. -o out/cloud.$F4.exr)",
+        args.output));
+  for (const std::string* name : {&args.preview, &args.deep})
+    if (!name->empty() && !has_frame_token(*name))
+      throw Error(fmt::format("--frames: '{}' holds no frame number ($F or $F4)", *name));
+  auto frame_args = [&](int f) {
+    RenderArgs a = args;
+    a.frames.reset();
+    a.frame = f;
+    a.output = substitute_frame(args.output, f);
+    a.preview = substitute_frame(args.preview, f);
+    a.deep = substitute_frame(args.deep, f);
+    return a;
+  };
+  for (const int f : frames) check_output_names(frame_args(f));  // every frame's names, before any work
+  for (const int f : frames)
+    if (const int rc = run_render(frame_args(f)); rc != kExitOk) return rc;
+  return kExitOk;
+}
+
 int run_render(RenderArgs args) {
+  if (args.frames) return run_frames(args);
   if (!args.resume.empty() && args.output.empty()) args.output = args.resume;
   if (args.output.empty()) throw Error("--output is required");
   check_output_names(args);
@@ -209,7 +249,8 @@ int run_render(RenderArgs args) {
   options.threads = args.threads;
   options.time_limit = args.time_limit;
   options.cancel = &g_cancel;
-  const std::string label = !args.resume.empty() ? args.resume : args.scene.empty() ? "demo" : args.scene;
+  std::string label = !args.resume.empty() ? args.resume : args.scene.empty() ? "demo" : args.scene;
+  if (args.frame) label += fmt::format(" frame {}", *args.frame);
   ProgressBar bar(fmt::format("nimbus: {}", label), !args.quiet && stderr_is_terminal());
   options.setup = [&bar](const std::string& what) { bar.stage(what); };
   options.progress = [&bar](int64_t done, int64_t total, int64_t samples) {
@@ -222,6 +263,7 @@ int run_render(RenderArgs args) {
   std::signal(SIGINT, SIG_DFL);
   std::signal(SIGTERM, SIG_DFL);
   bar.finish();
+  if (args.frame) result.metadata.emplace_back("nimbus/frame", std::to_string(*args.frame));
 
   if (result.nonfinite_samples > 0)
     fmt::print(stderr, "nimbus: warning: {} non-finite samples were dropped\n", result.nonfinite_samples);
@@ -299,6 +341,10 @@ void add_render_command(CLI::App& app, Action& action) {
   cmd->add_option("--samples", args->samples,
                   "Take sample indices START..START+COUNT-1 of every pixel (START:COUNT, instead of --spp): "
                   "renders of disjoint ranges combine with `nimbus merge`");
+  cmd->add_option("--frames", args->frames,
+                  "Render a sequence, frame by frame: LIST like 1-240, 1-10x2 (every 2nd), 1,3,5 or 1-4,10; "
+                  "$F (the frame) and $F4 (zero-padded to 4 digits) are replaced in every string of the "
+                  "scene (volume and mesh files...), in --set values and in -o, --preview, --deep");
   cmd->add_flag("-q,--quiet", args->quiet, "No progress bar or summary");
   cmd->callback([args, &action] { action = [args] { return run_render(*args); }; });
 }
