@@ -155,6 +155,10 @@ TEST(MergeCli, SampleRangesAddUpToTheRenderOfAllSamples) {
   expect_crop_of(dir / "all.exr", dir / "full.exr");
   ASSERT_EQ(run(s + "--samples 0:2 -o " + (dir / "a.exr").string()), 0);
   ASSERT_EQ(run(s + "--samples 2:3 -o " + (dir / "b.exr").string()), 0);
+  // A range resumed to more samples keeps its start: the same as the range rendered in one go.
+  ASSERT_EQ(run(s + "--samples 2:1 -o " + (dir / "b1.exr").string()), 0);
+  ASSERT_EQ(run("render --quiet --resume " + (dir / "b1.exr").string() + " --spp 3"), 0);
+  expect_crop_of(dir / "b1.exr", dir / "b.exr");
   ImageMetadata bm;
   read_exr(dir / "b.exr", &bm);
   EXPECT_EQ(meta_value(bm, "nimbus/sample_start"), "2");
@@ -216,6 +220,13 @@ TEST(MergeCli, IncompatibleInputsAreRefusedNamingFileAndField) {
     EXPECT_NE(err.find(".exr"), std::string::npos) << err;
     EXPECT_FALSE(fs::exists(dir / "m.exr")) << c.render;
   }
+}
+
+TEST(MergeCli, NonRendersAndBadSampleRangesAreRefused) {
+  const test::ScratchDir dir("merge_bad_ranges");
+  write_scene(dir / "s.json", 2);
+  const std::string s = "render " + (dir / "s.json").string() + " --quiet ";
+  ASSERT_EQ(run(s + "--samples 0:2 -o " + (dir / "a.exr").string()), 0);
   // Not a nimbus render, --samples beside --spp, a bad range: exit 2.
   write_exr(dir / "plain.exr", read_exr(dir / "a.exr"));
   EXPECT_EQ(run("merge " + (dir / "a.exr").string() + " " + (dir / "plain.exr").string() + " -o " +
