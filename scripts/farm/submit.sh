@@ -24,6 +24,8 @@ split_sbatch() {  # sbatch options up to a lone --, the rest for nimbus render
     shift
   fi
   render=("$@")
+  rargs=$(printf ' %q' "${render[@]}")  # quoted for the task's shell
+  [[ ${#render[@]} -gt 0 ]] || rargs=""
 }
 case $mode in
 sequence)
@@ -36,7 +38,7 @@ sequence)
   array=${frames//x/:}  # Slurm writes steps as A-B:S
   # Each task: the frame's output name, then task.sh.
   sbatch --parsable --array="$array" --job-name=nimbus-seq -o "$(dirname "$out")/logs/%A_%a.log" \
-    "${sb[@]}" --wrap "'$here/task.sh' '$nimbus' '$out' \$SLURM_ARRAY_TASK_ID '$scene' ${render[*]:-}"
+    "${sb[@]}" --wrap "'$here/task.sh' '$nimbus' '$out' \$SLURM_ARRAY_TASK_ID '$scene' $rargs"
   ;;
 split)
   scene=$(realpath "${1:?SCENE}"); out=$(realpath -m "${2:?OUT}"); tx=${3:?TX}; ty=${4:?TY}; k=${5:?RANGES}; spp=${6:?SPP}
@@ -55,7 +57,7 @@ split)
     x0=\$((ix * $w / $tx)); x1=\$(((ix + 1) * $w / $tx)); y0=\$((iy * $h / $ty)); y1=\$(((iy + 1) * $h / $ty))
     s0=\$((r * $spp / $k)); s1=\$(((r + 1) * $spp / $k))
     '$here/task.sh' '$nimbus' '$parts'/part_\${ix}_\${iy}_\${r}.exr - '$scene' --region \$x0,\$y0,\$x1,\$y1 \
-      --samples \$s0:\$((s1 - s0)) ${render[*]:-}")
+      --samples \$s0:\$((s1 - s0)) $rargs")
   echo "$jid"
   sbatch --parsable --dependency=afterok:"$jid" --job-name=nimbus-merge -o "$parts/logs/merge_%j.log" "${sb[@]}" \
     --wrap "'$nimbus' merge --quiet '$parts'/part_*.exr -o '$out'"
