@@ -5,6 +5,7 @@
 # Also: make (build only), make python (the Python module in build/python/: docs/python.md),
 # make test-fast (no statistical tests), make asan (sanitizer build + fast tests),
 # make fuzz-smoke (libFuzzer targets, 60 s each), make fuzz FUZZ_SECONDS=N (N s each): docs/reliability.md.
+# make farm-test (as root: a one-node Slurm cluster renders a sequence, a split frame, a killed task): docs/farm.md.
 BUILD ?= build
 JOBS ?= $(shell nproc)
 CMAKE_FLAGS ?=
@@ -13,7 +14,7 @@ FUZZ_SECONDS ?= 600
 # the ones the other fast tests already take there.
 ASAN_SKIP ?= ^Stress\.ExtremeScenesHaveNoNonFiniteSamples$$|^Determinism\.EveryIntegratorIsBitIdenticalForAnyThreadCount$$
 
-.PHONY: all deps configure build python demo test test-fast asan bench clean fuzz-build fuzz-smoke fuzz fuzz-seeds
+.PHONY: all deps configure build python demo test test-fast asan bench clean fuzz-build fuzz-smoke fuzz fuzz-seeds farm-test
 
 all: build
 
@@ -50,6 +51,12 @@ asan: deps
 
 bench: build
 	$(BUILD)/bin/bench_render
+
+# A one-node Slurm cluster on this machine (as root), a sequence, a split frame and a killed task:
+# scripts/farm/farm_test.sh, docs/farm.md. Bounded by timeout; the daemons stop on every exit.
+farm-test: deps
+	@$(MAKE) --no-print-directory build
+	timeout 600 ./scripts/farm/farm_test.sh $(BUILD)
 
 # libFuzzer targets (fuzz/): clang-14, ASan + UBSan, in build-fuzz/. See docs/reliability.md.
 build-fuzz/build.ninja:

@@ -13,6 +13,7 @@ packages=(
   libembree-dev libtinyobjloader-dev
   clang-14 libclang-rt-14-dev
   python3 python3-numpy python3-matplotlib python3-dev pybind11-dev python3-pybind11
+  slurm-wlm munge
 )
 
 missing=()

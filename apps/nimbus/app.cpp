@@ -16,6 +16,7 @@ void build_app(CLI::App& app, Action& action) {
   add_convert_command(app, action);
   add_beam_command(app, action);
   add_slab_command(app, action);
+  add_merge_command(app, action);
 }
 
 }  // namespace nimbus::cli

@@ -2,10 +2,11 @@
 // propagator (Dolin, Tessendorf 87/88, the corrected MFS kernel, the generalised small-angle one),
 // tallied at planes of given optical depth.  Lengths in scattering mean free paths (b = 1).
 //
-// CSV columns: model,depth,quantity,lo,hi,value,stderr with quantity
-//   angular     bins of polar angle [rad]; plane-integrated scattered radiance per sr per source photon
-//   radial      bins of radius [mfp]; forward scattered flux per unit area per source photon
-//   unscattered lo = hi = 0; unscattered flux through the plane
+// CSV columns (docs/cli.md): model,depth,quantity,lo,hi,value,stderr,bin_unit,value_unit; depth in mfp,
+// quantity
+//   angular     bins [lo, hi) of polar angle [rad]; plane-integrated scattered radiance [1/sr per photon]
+//   radial      bins of radius [mfp]; forward scattered flux per unit area [1/mfp^2 per photon]
+//   unscattered lo = hi = 0; unscattered flux through the plane [per photon]
 // With --time-edges (t0,t1,... or lo:hi:N, in mfp; time = n * path length):
 //   delay          bins of the delay n (s - z) [mfp] of scattered light crossing the plane forward
 //                  (weight per bin per source photon; rows 0..t0 if t0 > 0 and t_last..inf hold the rest);
@@ -84,10 +85,21 @@ int run_beam(const BeamArgs& a) {
   if (models.empty()) throw Error("--models: empty list");
 
   const std::vector<BeamRow> rows = beam_table(s, models);
-  std::string text = "model,depth,quantity,lo,hi,value,stderr\n";
-  for (const BeamRow& r : rows)
-    text += fmt::format("{},{:.9g},{},{:.9g},{:.9g},{:.9g},{:.9g}\n", r.model, r.depth, r.quantity, r.lo,
-                        r.hi, r.value, r.stderr_);
+  // The units of each row's bins and values, in the last two columns (after the columns scripts read).
+  auto units = [](const std::string& q) -> std::pair<const char*, const char*> {
+    if (q == "angular") return {"rad", "1/sr per photon"};
+    if (q == "radial") return {"mfp", "1/mfp^2 per photon"};
+    if (q == "delay") return {"mfp", "per photon"};
+    if (q == "delay_mean") return {"none", "mfp"};
+    if (q == "delay_variance") return {"none", "mfp^2"};
+    return {"none", "per photon"};
+  };
+  std::string text = "model,depth,quantity,lo,hi,value,stderr,bin_unit,value_unit\n";
+  for (const BeamRow& r : rows) {
+    const auto [bin_unit, value_unit] = units(r.quantity);
+    text += fmt::format("{},{:.9g},{},{:.9g},{:.9g},{:.9g},{:.9g},{},{}\n", r.model, r.depth, r.quantity,
+                        r.lo, r.hi, r.value, r.stderr_, bin_unit, value_unit);
+  }
   if (a.out.empty() || a.out == "-") {
     std::fwrite(text.data(), 1, text.size(), stdout);
   } else {

@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
+#include "heatmap_legend.h"
 #include "nimbus/compare.h"
 #include "nimbus/image.h"
 
@@ -24,7 +25,9 @@ int run_compare(const CompareArgs& args) {
   o.bin = args.bin;
   o.min_reference = args.min_ref;
   const CompareResult r = compare_images(a, b, o);
-  if (!args.heatmap.empty()) write_image(args.heatmap, error_heatmap(a, b, o, args.heatmap_range), {}, 0.0);
+  if (!args.heatmap.empty())
+    write_image(args.heatmap,
+                with_heatmap_legend(error_heatmap(a, b, o, args.heatmap_range), args.heatmap_range), {}, 0.0);
   if (args.json) {
     const nlohmann::json j = {{"a", args.a},
                               {"b", args.b},
@@ -65,7 +68,9 @@ void add_compare_command(CLI::App& app, Action& action) {
   cmd->add_option("--min-ref", args->min_ref,
                   "Exclude bins whose reference luminance is below this fraction of the mean")
       ->check(CLI::Range(0.0, 1e6));
-  cmd->add_option("--heatmap", args->heatmap, "Write the signed relative error as an image (.png or .exr)");
+  cmd->add_option(
+      "--heatmap", args->heatmap,
+      "Write the signed relative error as an image (.png or .exr), a colour bar with its scale below it");
   cmd->add_option("--heatmap-range", args->heatmap_range, "Relative error shown at full colour")
       ->check(CLI::Range(1e-6, 1e6));
   cmd->add_flag("--json", args->json, "Print the metrics as one JSON object");

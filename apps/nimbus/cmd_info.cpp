@@ -2,16 +2,33 @@
 // index and world bboxes, voxel size, value range). Bad input: `nimbus: error: FILE: message`, exit 2.
 #include <fmt/format.h>
 
+#include <filesystem>
 #include <string>
 
 #include "commands.h"
 #include "io/vdb.h"
+#include "nimbus/image.h"
 
 namespace nimbus::cli {
 
 namespace {
 
+// An EXR: its size, window and string attributes (a nimbus render's header: nimbus/spp, nimbus/partial...).
+int run_exr_info(const std::string& path) {
+  ImageMetadata meta;
+  const Image img = read_exr(path, &meta);
+  fmt::print("{}: {}x{} pixels", path, img.width, img.height);
+  if (img.display_width != 0)
+    fmt::print(" at ({}, {}) of {}x{}", img.origin_x, img.origin_y, img.display_width, img.display_height);
+  fmt::print("\n");
+  for (const auto& [k, v] : meta) fmt::print("{} {}\n", k, v);
+  return kExitOk;
+}
+
 int run_info(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+  if (ext == ".exr") return run_exr_info(path);
   const std::vector<GridInfo> grids = inspect_volume_file(path);
   fmt::print("{}: {} grid{}\n", path, grids.size(), grids.size() == 1 ? "" : "s");
   for (size_t i = 0; i < grids.size(); ++i) {
@@ -45,9 +62,13 @@ int run_info(const std::string& path) {
 }  // namespace
 
 void add_info_command(CLI::App& app, Action& action) {
-  auto* cmd = app.add_subcommand("info", "List the grids of a volume file (.vdb or .nvdb)");
+  auto* cmd =
+      app.add_subcommand("info", "List the grids of a volume file (.vdb or .nvdb), or an EXR's header");
   auto path = std::make_shared<std::string>();
-  cmd->add_option("file", *path, "OpenVDB (.vdb) or NanoVDB (.nvdb) file")->required();
+  cmd->add_option(
+         "file", *path,
+         "OpenVDB (.vdb) or NanoVDB (.nvdb) file, or an EXR (its size and header attributes, one per line)")
+      ->required();
   cmd->footer(
       "The world bbox is the active index bbox (voxel centres) through the grid's transform.\n"
       "Exit status 2 on a missing, unreadable or corrupt file.");

@@ -9,11 +9,13 @@
 #include <optional>
 
 #include "commands.h"
+#include "frames.h"
 #include "nimbus/error.h"
 #include "nimbus/image.h"
 #include "nimbus/render.h"
 #include "nimbus/scene.h"
 #include "progress.h"
+#include "ranges.h"
 
 namespace nimbus::cli {
 
@@ -43,12 +45,16 @@ struct RenderArgs {
   int deep_samples = 32;
   int threads = 0;
   double exposure = 0.0;
-  double time_limit = 0.0;        // --time: seconds, 0 = none
-  std::string resume;             // --resume: the EXR to continue
-  std::vector<std::string> sets;  // --set PATH=VALUE
-  std::string res;                // --res WxH
-  double noise = 0.0;             // --noise: adaptive sampling to this binned relative RMSE
-  int noise_bin = 4;              // --noise-bin
+  double time_limit = 0.0;            // --time: seconds, 0 = none
+  std::string resume;                 // --resume: the EXR to continue
+  std::vector<std::string> sets;      // --set PATH=VALUE
+  std::string res;                    // --res WxH
+  std::string region;                 // --region x0,y0,x1,y1
+  std::string samples;                // --samples START:COUNT
+  std::optional<std::string> frames;  // --frames LIST: a sequence, $F / $F4 in file names
+  std::optional<int> frame;           // the frame this run renders (one of --frames)
+  double noise = 0.0;                 // --noise: adaptive sampling to this binned relative RMSE
+  int noise_bin = 4;                  // --noise-bin
   bool quiet = false;
 };
 
@@ -89,17 +95,30 @@ std::string meta_value(const ImageMetadata& meta, const std::string& key, const 
   throw Error(fmt::format("{}: no {} in the header (not a nimbus render?)", file, key));
 }
 
+// The region and sample range a resumed render had (absent in files from before them: none).
+void resume_window(const ImageMetadata& meta, const std::string& file, RenderOptions* options) {
+  for (const auto& [k, v] : meta) {
+    if (k == "nimbus/region") options->region = parse_region(v, file + ": nimbus/region");
+    if (k == "nimbus/sample_start") {
+      char extra = 0;
+      if (std::sscanf(v.c_str(), "%d%c", &options->sample_start, &extra) != 1 || options->sample_start < 0)
+        throw Error(fmt::format("{}: nimbus/sample_start '{}' is not a sample index", file, v));
+    }
+  }
+}
+
 // --resume FILE: the scene, spp and film state of a nimbus EXR. The render goes on to args.spp, or to
 // the spp the file asked for.
-Scene resume_scene(const RenderArgs& args, FilmState* state, std::optional<int>* spp) {
+Scene resume_scene(const RenderArgs& args, FilmState* state, RenderOptions* options) {
+  std::optional<int>* spp = &options->spp;
   if (!args.scene.empty())
     throw Error(
         fmt::format("--resume: {}: the scene comes from the EXR's header; give no scene file", args.scene));
   if (args.integrator || args.seed || args.layers_given || !args.deep.empty() || !args.sets.empty() ||
-      !args.res.empty())
+      !args.res.empty() || !args.region.empty() || !args.samples.empty())
     throw Error(
-        "--resume: --integrator, --seed, --layers, --deep, --set and --res must be those of the resumed "
-        "render");
+        "--resume: --integrator, --seed, --layers, --deep, --set, --res, --region and --samples must be "
+        "those of the resumed render");
   ImageMetadata meta;
   read_exr(args.resume, &meta);
   *state = read_exr_state(args.resume);
@@ -112,6 +131,7 @@ Scene resume_scene(const RenderArgs& args, FilmState* state, std::optional<int>*
   }
   Scene scene = parse_scene(doc, args.resume + " (nimbus/scene)", file.parent_path());
   scene.file = file;
+  resume_window(meta, args.resume, options);
   const int requested = scene.integrator.spp;
   *spp = args.spp ? *args.spp : requested;
   if (**spp <= state->spp && args.noise <= 0.0)
@@ -146,14 +166,62 @@ std::vector<std::string> scene_overrides(const RenderArgs& args) {
 
 Scene load_render_scene(const RenderArgs& args) {
   const std::vector<std::string> sets = scene_overrides(args);
-  if (!args.scene.empty()) return load_scene(args.scene, sets);
-  if (sets.empty()) return builtin_demo_scene();
-  nlohmann::json doc = builtin_demo_document();
+  if (!args.frame) {
+    if (!args.scene.empty()) return load_scene(args.scene, sets);
+    if (sets.empty()) return builtin_demo_scene();
+  }
+  // The document, its overrides, then (a frame of a sequence) $F in every string: file names and all.
+  nlohmann::json doc = args.scene.empty() ? builtin_demo_document() : read_scene_document(args.scene);
   for (const std::string& o : sets) apply_scene_override(doc, o);
-  return parse_scene(doc, "(built-in demo)", ".");
+  if (args.frame) substitute_frame(doc, *args.frame);
+  if (args.scene.empty()) return parse_scene(doc, "(built-in demo)", ".");
+  Scene scene = parse_scene(doc, args.scene, std::filesystem::path(args.scene).parent_path());
+  scene.file = args.scene;
+  return scene;
+}
+
+// --region against the scene's image size (the library checks again, without the option's name).
+void check_region(const RenderArgs& args, const Scene& scene, const RenderOptions& options) {
+  const Region& r = *options.region;
+  const int w = scene.camera.width, h = scene.camera.height;
+  if (!(0 <= r.x0 && r.x0 < r.x1 && r.x1 <= w && 0 <= r.y0 && r.y0 < r.y1 && r.y1 <= h))
+    throw Error(fmt::format(
+        "--region {}: not a window inside the {}x{} image (x0,y0,x1,y1 in pixels, half-open: 0 <= x0 < "
+        "x1 <= {}, 0 <= y0 < y1 <= {})",
+        args.region, w, h, w, h));
+}
+
+int run_render(RenderArgs args);
+
+// --frames: the frames one after another, $F in the scene's strings and the output names. Stops at the
+// first frame that fails (a bad scene exits 2 naming it, an interrupted frame 1).
+int run_frames(const RenderArgs& args) {
+  const std::vector<int> frames = parse_frames(*args.frames);
+  if (!args.resume.empty()) throw Error("--frames: not with --resume (resume each frame's file)");
+  if (!has_frame_token(args.output))
+    throw Error(fmt::format(
+        "--frames: the output '{}' holds no frame number: write $F or $F4 in it (e.g. -o out/cloud.$F4.exr)",
+        args.output));
+  for (const std::string* name : {&args.preview, &args.deep})
+    if (!name->empty() && !has_frame_token(*name))
+      throw Error(fmt::format("--frames: '{}' holds no frame number ($F or $F4)", *name));
+  auto frame_args = [&](int f) {
+    RenderArgs a = args;
+    a.frames.reset();
+    a.frame = f;
+    a.output = substitute_frame(args.output, f);
+    a.preview = substitute_frame(args.preview, f);
+    a.deep = substitute_frame(args.deep, f);
+    return a;
+  };
+  for (const int f : frames) check_output_names(frame_args(f));  // every frame's names, before any work
+  for (const int f : frames)
+    if (const int rc = run_render(frame_args(f)); rc != kExitOk) return rc;
+  return kExitOk;
 }
 
 int run_render(RenderArgs args) {
+  if (args.frames) return run_frames(args);
   if (!args.resume.empty() && args.output.empty()) args.output = args.resume;
   if (args.output.empty()) throw Error("--output is required");
   check_output_names(args);
@@ -162,15 +230,26 @@ int run_render(RenderArgs args) {
   FilmState state;
   std::optional<Scene> resumed;
   if (!args.resume.empty()) {
-    resumed.emplace(resume_scene(args, &state, &options.spp));
+    resumed.emplace(resume_scene(args, &state, &options));
     options.resume = &state;
   } else {
     options.spp = args.spp;
     if (args.noise > 0.0 && !args.spp) options.spp = kAdaptiveDefaultMaxSpp;
+    if (!args.region.empty()) options.region = parse_region(args.region, "--region");
+    if (!args.samples.empty()) {
+      if (args.spp) throw Error("--samples START:COUNT sets the spp (COUNT): give no --spp");
+      const auto [start, count] = parse_samples(args.samples);
+      options.sample_start = start;
+      options.spp = count;
+    }
+    if ((options.region || options.sample_start > 0) && !args.deep.empty())
+      throw Error(
+          "--deep: a deep image is made of the whole image and all its samples (no --region, --samples)");
   }
   options.noise = args.noise;
   options.noise_bin = args.noise_bin;
   const Scene scene = resumed ? std::move(*resumed) : load_render_scene(args);
+  if (options.region && args.resume.empty()) check_region(args, scene, options);
   options.seed = args.seed;
   options.integrator = args.integrator;
   if (args.layers_given) options.layers = args.layers;
@@ -178,7 +257,8 @@ int run_render(RenderArgs args) {
   options.threads = args.threads;
   options.time_limit = args.time_limit;
   options.cancel = &g_cancel;
-  const std::string label = !args.resume.empty() ? args.resume : args.scene.empty() ? "demo" : args.scene;
+  std::string label = !args.resume.empty() ? args.resume : args.scene.empty() ? "demo" : args.scene;
+  if (args.frame) label += fmt::format(" frame {}", *args.frame);
   ProgressBar bar(fmt::format("nimbus: {}", label), !args.quiet && stderr_is_terminal());
   options.setup = [&bar](const std::string& what) { bar.stage(what); };
   options.progress = [&bar](int64_t done, int64_t total, int64_t samples) {
@@ -191,6 +271,7 @@ int run_render(RenderArgs args) {
   std::signal(SIGINT, SIG_DFL);
   std::signal(SIGTERM, SIG_DFL);
   bar.finish();
+  if (args.frame) result.metadata.emplace_back("nimbus/frame", std::to_string(*args.frame));
 
   if (result.nonfinite_samples > 0)
     fmt::print(stderr, "nimbus: warning: {} non-finite samples were dropped\n", result.nonfinite_samples);
@@ -275,6 +356,16 @@ void add_render_command(CLI::App& app, Action& action) {
   cmd->add_option("--resume", args->resume,
                   "Continue this EXR (a partial or finished nimbus render) to more samples (--spp, default "
                   "the spp it asked for); the scene comes from its header. Bit-identical to one render");
+  cmd->add_option("--region", args->region,
+                  "Render only the crop window x0,y0,x1,y1 (pixels of the full image, row 0 at the top, "
+                  "half-open: x0 <= x < x1); the EXR keeps the full display window, the crop as data window");
+  cmd->add_option("--samples", args->samples,
+                  "Take sample indices START..START+COUNT-1 of every pixel (START:COUNT, instead of --spp): "
+                  "renders of disjoint ranges combine with `nimbus merge`");
+  cmd->add_option("--frames", args->frames,
+                  "Render a sequence, frame by frame: LIST like 1-240, 1-10x2 (every 2nd), 1,3,5 or 1-4,10; "
+                  "$F (the frame) and $F4 (zero-padded to 4 digits) are replaced in every string of the "
+                  "scene (volume and mesh files...), in --set values and in -o, --preview, --deep");
   cmd->add_flag("-q,--quiet", args->quiet, "No progress bar or summary");
   cmd->callback([args, &action] { action = [args] { return run_render(*args); }; });
 }

@@ -2,8 +2,9 @@
 // (physical units: any consistent length unit).  Prints `name value stderr` lines for specular,
 // diffuse_reflectance, transmittance (unscattered included), unscattered_transmittance and absorbed;
 // --csv [FILE] adds angle- and radius-resolved reflectance and transmittance (to FILE or stdout):
-//   side,quantity,lo,hi,value,stderr   side = reflect|transmit, quantity = angular (per sr of exit
-//   solid angle, exit polar angle outside the slab, rad) or radial (per unit area, exit radius).
+//   side,quantity,lo,hi,value,stderr,bin_unit,value_unit   side = reflect|transmit, quantity = angular
+//   (per sr of exit solid angle, bins of exit polar angle outside the slab, rad) or radial (per unit
+//   area, bins of exit radius, length). docs/cli.md.
 // --time-edges t0,t1,... or lo:hi:N adds time-resolved exits (to --time-csv FILE, or stdout):
 //   tlo,thi,reflectance,reflectance_stderr,transmittance,transmittance_stderr
 //   time = n * path length in the medium (c = 1 in vacuum), in the length unit of --thickness; values are
@@ -14,6 +15,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -21,6 +23,7 @@
 #include "core/math.h"
 #include "io/atomic_file.h"
 #include "nimbus/error.h"
+#include "transport/phase_spec.h"
 #include "transport/photon_mc.h"
 #include "transport/time_resolved.h"
 
@@ -29,7 +32,9 @@ namespace nimbus::cli {
 namespace {
 
 struct SlabArgs {
-  double mu_s = -1.0, mu_a = -1.0, g = 0.0, thickness = -1.0, n = 1.0, photons = 1e6;
+  double mu_s = -1.0, mu_a = -1.0, thickness = -1.0, n = 1.0, photons = 1e6;
+  std::optional<double> g_given;  // --g G: hg:G
+  std::string phase;              // --phase SPEC, as beam's
   uint64_t seed = 1;
   int angle_bins = 30, r_bins = 50;
   double r_max = 0.0;
@@ -79,7 +84,19 @@ int run_slab(const SlabArgs& a) {
   // sigma_t and a slab that reflected everything.
   if (!std::isfinite(a.mu_s + a.mu_a))
     throw Error(fmt::format("--mu-s + --mu-a must be finite (got {} + {})", a.mu_s, a.mu_a));
-  if (!(a.g > -1.0 && a.g < 1.0)) throw Error(fmt::format("--g must lie in (-1, 1) (got {})", a.g));
+  if (a.g_given && !a.phase.empty()) throw Error("--g and --phase: give one (--g G is --phase hg:G)");
+  if (!a.g_given && a.phase.empty()) throw Error("--phase (or --g) is required");
+  if (a.g_given && !(*a.g_given > -1.0 && *a.g_given < 1.0))
+    throw Error(fmt::format("--g must lie in (-1, 1) (got {})", *a.g_given));
+  Phase phase = HgPhase{a.g_given.value_or(0.0)};
+  if (!a.phase.empty()) {
+    try {
+      phase = parse_phase_spec(a.phase);
+    } catch (const Error& e) {
+      throw Error(fmt::format("--phase: {}", e.what()));
+    }
+  }
+  const double g = phase_mean_cosine(phase);
   if (!(a.thickness > 0.0) || !std::isfinite(a.thickness))
     throw Error(fmt::format("--thickness must be > 0 (got {})", a.thickness));
   if (!(a.n >= 1.0) || !std::isfinite(a.n) || a.n > 10.0)
@@ -90,7 +107,7 @@ int run_slab(const SlabArgs& a) {
   PhotonMcSettings s;
   s.sigma_s = a.mu_s;
   s.sigma_a = a.mu_a;
-  s.phase = HgPhase{a.g};
+  s.phase = phase;
   s.thickness = a.thickness;
   s.n = a.n;
   s.photons = uint64_t(a.photons);
@@ -98,7 +115,7 @@ int run_slab(const SlabArgs& a) {
   s.batches = 20;
   if (a.time_given) s.time_edges = parse_time_edges("--time-edges", a.time_edges);
   for (int i = 0; i <= a.angle_bins; ++i) s.theta_edges.push_back(0.5 * kPi * i / a.angle_bins);
-  const double transport = a.mu_a + a.mu_s * (1.0 - a.g);
+  const double transport = a.mu_a + a.mu_s * (1.0 - g);
   const double r_max =
       a.r_max > 0.0 ? a.r_max : 5.0 * std::max(a.thickness, transport > 0.0 ? 1.0 / transport : a.thickness);
   for (int i = 0; i <= a.r_bins; ++i) s.r_edges.push_back(r_max * i / a.r_bins);
@@ -117,12 +134,14 @@ int run_slab(const SlabArgs& a) {
   if (a.time_given && !write_text(a.time_csv, time_csv(s.time_edges, r))) return kExitFailure;
   if (!a.csv) return kExitOk;
 
-  std::string csv = "side,quantity,lo,hi,value,stderr\n";
+  std::string csv = "side,quantity,lo,hi,value,stderr,bin_unit,value_unit\n";
   auto rows = [&](const char* side, const char* q, const std::vector<double>& edges,
                   const std::vector<Estimate>& v) {
+    const bool angular = std::string(q) == "angular";
     for (size_t i = 0; i < v.size(); ++i)
-      csv += fmt::format("{},{},{:.9g},{:.9g},{:.9g},{:.9g}\n", side, q, edges[i], edges[i + 1], v[i].value,
-                         v[i].err);
+      csv += fmt::format("{},{},{:.9g},{:.9g},{:.9g},{:.9g},{},{}\n", side, q, edges[i], edges[i + 1],
+                         v[i].value, v[i].err, angular ? "rad" : "length",
+                         angular ? "1/sr per photon" : "1/length^2 per photon");
   };
   rows("reflect", "angular", s.theta_edges, r.reflect_angular);
   rows("reflect", "radial", s.r_edges, r.reflect_radial);
@@ -136,11 +155,14 @@ int run_slab(const SlabArgs& a) {
 void add_slab_command(CLI::App& app, Action& action) {
   auto args = std::make_shared<SlabArgs>();
   auto* cmd = app.add_subcommand("slab",
-                                 "Photon Monte Carlo of a pencil beam on a slab (MCML conventions, HG phase, "
-                                 "physical units)");
+                                 "Photon Monte Carlo of a pencil beam on a slab (MCML conventions, any phase "
+                                 "function beam accepts, physical units)");
   cmd->add_option("--mu-s", args->mu_s, "Scattering coefficient [1/length]")->required();
   cmd->add_option("--mu-a", args->mu_a, "Absorption coefficient [1/length]")->required();
-  cmd->add_option("--g", args->g, "Henyey-Greenstein asymmetry g")->required();
+  cmd->add_option("--g", args->g_given, "Henyey-Greenstein asymmetry g (the same as --phase hg:G)");
+  cmd->add_option(
+      "--phase", args->phase,
+      "Phase function, as beam's: iso, hg:G, dhg:G1,G2,W, gauss:THETA2, mie:NAME or mie:FILE.csv");
   cmd->add_option("--thickness", args->thickness, "Slab thickness [length]")->required();
   cmd->add_option("--n", args->n, "Refractive index of the slab against 1 outside (default 1)");
   cmd->add_option("--photons", args->photons, "Photons (default 1e6)");

@@ -32,5 +32,8 @@ CompareResult compare_images(const Image& a, const Image& b, const CompareOption
 // Signed relative error per bin, (Y_a - Y_b) / Y_b, mapped blue (a < b) - white - red (a > b) with
 // full colour at +-max_rel; excluded bins grey; at full image size.
 Image error_heatmap(const Image& a, const Image& b, const CompareOptions& options = {}, double max_rel = 0.5);
+// The heatmap's colour (linear RGB) of a relative error e / max_rel, clamped to [-1, 1]: white at 0,
+// pure red at +1, pure blue at -1.
+void heatmap_colour(double e, float rgb[3]);
 
 }  // namespace nimbus

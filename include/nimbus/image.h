@@ -25,6 +25,10 @@ struct Image {  // linear RGB, row-major, row 0 = top, 3 floats per pixel
   std::vector<float> alpha;
   // Further channels for the EXR (the compositing layers); PNG output ignores them.
   std::vector<ImageChannel> channels;
+  // A crop of a larger image (render --region): its pixels start at (origin_x, origin_y) of a display
+  // window of display_width x display_height; written to EXR as that data window inside that display
+  // window. display_width == 0: the image is its whole display window (origin 0).
+  int origin_x = 0, origin_y = 0, display_width = 0, display_height = 0;
   Image() = default;
   Image(int w, int h);  // zero-filled; throws nimbus::Error for sizes <= 0 or over 2^28 pixels
   float* pixel(int x, int y) { return &rgb[(size_t(y) * width + x) * 3]; }
@@ -54,7 +58,8 @@ using ImageMetadata = std::vector<std::pair<std::string, std::string>>;
 void write_exr(const std::filesystem::path& path, const Image& img, const ImageMetadata& meta = {},
                const FilmState* state = nullptr);
 // Reads R, G, B (any pixel type; a missing channel reads as 0), A when present, and the string
-// attributes; further channels are not read.
+// attributes; further channels are not read. The image is the data window; a data window other than the
+// display window sets the origin and display size.
 Image read_exr(const std::filesystem::path& path, ImageMetadata* meta = nullptr);
 // The film state of an EXR written with one; throws nimbus::Error (naming the file) when it has none or
 // the state is malformed.

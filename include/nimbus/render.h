@@ -12,6 +12,12 @@
 
 namespace nimbus {
 
+// A crop window (render --region): pixels x0 <= x < x1, y0 <= y < y1 of the full image, row 0 at the
+// top: half-open, as OpenEXR's data window [x0, x1 - 1] x [y0, y1 - 1]. docs/cli.md.
+struct Region {
+  int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+};
+
 struct RenderOptions {
   std::optional<int> spp;        // overrides the scene's integrator.spp
   std::optional<uint64_t> seed;  // overrides integrator.seed
@@ -41,9 +47,16 @@ struct RenderOptions {
   const FilmState* resume = nullptr;
   // > 0: adaptive sampling (render --noise). Passes go on until the estimated binned relative RMSE
   // against a noise-free image (nimbus compare --bin noise_bin --min-ref 0.05) is at most `noise`,
-  // each pixel taking samples as its variance asks; the spp is then the most any pixel may take.
+  // each pixel taking samples as its variance asks; the spp is then the most any pixel may take. Not
+  // with a region or a sample range (the passes are planned over the whole image).
   double noise = 0.0;
   int noise_bin = 4;
+  // Only these pixels (render --region): the image is the crop, its origin and display size set; each
+  // pixel equals the full render's bit for bit (samples are seeded from the pixel in the full image).
+  std::optional<Region> region;
+  // The first sample index (render --samples START:COUNT): the render takes samples [sample_start,
+  // sample_start + spp) of every pixel, the same samples a render of sample_start + spp takes last.
+  int sample_start = 0;
 };
 
 // The passes of a progressive render: from `done` samples per pixel the next pass goes to twice as many
@@ -71,6 +84,7 @@ struct RenderResult {
   double noise_target = 0.0;    // RenderOptions::noise (0: not adaptive)
   double noise_estimate = 0.0;  // adaptive sampling: the estimated binned relative RMSE reached
   int spp_requested = 0;        // what the render asked for
+  int sample_start = 0;         // the samples taken: [sample_start, sample_start + spp)
   uint64_t seed = 0;
   // The integrator block as rendered: type, spp, seed, max_events and the integrator's own fields with
   // "auto" choices resolved (also in the EXR header as nimbus/integrator_settings).

@@ -104,13 +104,16 @@ Image error_heatmap(const Image& a, const Image& b, const CompareOptions& o, dou
         p[0] = p[1] = p[2] = 0.2f;
         continue;
       }
-      const double e = std::clamp((bins.a[i] - bins.b[i]) / bins.b[i] / max_rel, -1.0, 1.0);
-      // Linear values: white at 0, pure red at +1, pure blue at -1.
-      p[0] = float(e < 0 ? 1.0 + e : 1.0);
-      p[1] = float(1.0 - std::abs(e));
-      p[2] = float(e > 0 ? 1.0 - e : 1.0);
+      heatmap_colour((bins.a[i] - bins.b[i]) / bins.b[i] / max_rel, p);
     }
   return out;
+}
+
+void heatmap_colour(double e, float rgb[3]) {
+  e = std::isnan(e) ? 0.0 : std::clamp(e, -1.0, 1.0);
+  rgb[0] = float(e < 0 ? 1.0 + e : 1.0);
+  rgb[1] = float(1.0 - std::abs(e));
+  rgb[2] = float(e > 0 ? 1.0 - e : 1.0);
 }
 
 }  // namespace nimbus

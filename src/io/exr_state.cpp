@@ -33,19 +33,21 @@ std::string channel_name(const FilmState::Layer& l, int c, const char* half) {
   return fmt::format("{}{}_{}_{}", kPrefix, l.name, c, half);
 }
 
-// Slices of the state's doubles and counts: the low and high words of sums[channels * pixel + c].
-Imf::FrameBuffer state_frame_buffer(FilmState& st) {
+// Slices of the state's doubles and counts: the low and high words of sums[channels * pixel + c], for a
+// data window that starts at (ox, oy).
+Imf::FrameBuffer state_frame_buffer(FilmState& st, ptrdiff_t ox, ptrdiff_t oy) {
   Imf::FrameBuffer fb;
   for (FilmState::Layer& l : st.layers) {
     const size_t xs = sizeof(double) * size_t(l.channels), ys = xs * size_t(st.width);
     for (int c = 0; c < l.channels; ++c) {
-      char* base = reinterpret_cast<char*>(l.sums.data() + c);
+      char* base = reinterpret_cast<char*>(l.sums.data() + c) - ox * ptrdiff_t(xs) - oy * ptrdiff_t(ys);
       fb.insert(channel_name(l, c, "lo"), Imf::Slice(Imf::UINT, base, xs, ys));
       fb.insert(channel_name(l, c, "hi"), Imf::Slice(Imf::UINT, base + 4, xs, ys));
     }
   }
+  const ptrdiff_t first = ox + oy * ptrdiff_t(st.width);
   fb.insert(std::string(kPrefix) + "count",
-            Imf::Slice(Imf::UINT, reinterpret_cast<char*>(st.counts.data()), sizeof(uint32_t),
+            Imf::Slice(Imf::UINT, reinterpret_cast<char*>(st.counts.data() - first), sizeof(uint32_t),
                        sizeof(uint32_t) * size_t(st.width)));
   return fb;
 }
@@ -89,7 +91,8 @@ void write_exr_with_state(const fs::path& path, const Image& img, const ImageMet
     header.channels().insert(std::string(kPrefix) + "count", Imf::Channel(Imf::UINT));
     header.insert(kSppAttribute, Imf::IntAttribute(st.spp));
     Imf::FrameBuffer fb = exr_image_frame_buffer(img);
-    const Imf::FrameBuffer state = state_frame_buffer(st);
+    const Imath::Box2i dw = header.dataWindow();
+    const Imf::FrameBuffer state = state_frame_buffer(st, dw.min.x, dw.min.y);
     for (auto it = state.begin(); it != state.end(); ++it) fb.insert(it.name(), it.slice());
     Imf::OutputFile file(tmp.c_str(), header);
     file.setFrameBuffer(fb);
@@ -105,10 +108,9 @@ FilmState read_state(const fs::path& path) {
   const Imath::Box2i dw = h.dataWindow();
   const auto* spp = h.findTypedAttribute<Imf::IntAttribute>(kSppAttribute);
   if (!spp) throw Error("no resume state (nimbus writes one in every EXR render)");
-  if (dw.min.x != 0 || dw.min.y != 0) throw Error("malformed resume state");
-  FilmState st;
-  st.width = dw.max.x + 1;
-  st.height = dw.max.y + 1;
+  FilmState st;  // the data window's pixels (a crop: render --region)
+  st.width = dw.max.x - dw.min.x + 1;
+  st.height = dw.max.y - dw.min.y + 1;
   st.spp = spp->value();
   if (st.width < 1 || st.height < 1 || st.width > (1 << 16) || st.height > (1 << 16) ||
       size_t(st.width) * size_t(st.height) > (size_t(1) << 28))
@@ -131,12 +133,12 @@ FilmState read_state(const fs::path& path) {
   }
   for (const auto& [name, k] : channels) st.layers.push_back({name, k, std::vector<double>(n * size_t(k))});
   st.counts.assign(n, 0);
-  Imf::FrameBuffer fb = state_frame_buffer(st);
+  Imf::FrameBuffer fb = state_frame_buffer(st, dw.min.x, dw.min.y);
   for (auto it = fb.begin(); it != fb.end(); ++it)
     if (!h.channels().findChannel(it.name()))
       throw Error(fmt::format("resume channel '{}' missing", it.name()));
   file.setFrameBuffer(fb);
-  file.readPixels(0, st.height - 1);
+  file.readPixels(dw.min.y, dw.max.y);
   check_state(st);
   return st;
 }

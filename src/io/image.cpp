@@ -40,6 +40,10 @@ void check_image(const fs::path& path, const Image& img) {
   if (img.width <= 0 || img.height <= 0 || img.rgb.size() != n * 3 ||
       (!img.alpha.empty() && img.alpha.size() != n))
     throw Error(fmt::format("{}: cannot write an empty or malformed image", path.string()));
+  if (img.display_width != 0 &&
+      (img.origin_x < 0 || img.origin_y < 0 || int64_t(img.origin_x) + img.width > img.display_width ||
+       int64_t(img.origin_y) + img.height > img.display_height))
+    throw Error(fmt::format("{}: the image's data window is not inside its display window", path.string()));
   for (const ImageChannel& c : img.channels)
     if (c.data.size() != n || c.name.empty() || c.name == "R" || c.name == "G" || c.name == "B" ||
         c.name == "A")
@@ -50,6 +54,11 @@ void check_image(const fs::path& path, const Image& img) {
 
 Imf::Header exr_image_header(const Image& img, const ImageMetadata& meta) {
   Imf::Header header(img.width, img.height);
+  if (img.display_width != 0) {
+    header.displayWindow() = Imath::Box2i({0, 0}, {img.display_width - 1, img.display_height - 1});
+    header.dataWindow() = Imath::Box2i({img.origin_x, img.origin_y},
+                                       {img.origin_x + img.width - 1, img.origin_y + img.height - 1});
+  }
   header.compression() = Imf::ZIP_COMPRESSION;
   for (const char* c : {"R", "G", "B"}) header.channels().insert(c, Imf::Channel(Imf::FLOAT));
   if (!img.alpha.empty()) header.channels().insert("A", Imf::Channel(Imf::FLOAT));
@@ -60,13 +69,18 @@ Imf::Header exr_image_header(const Image& img, const ImageMetadata& meta) {
 
 Imf::FrameBuffer exr_image_frame_buffer(const Image& img) {
   Imf::FrameBuffer fb;
-  char* base = reinterpret_cast<char*>(const_cast<float*>(img.rgb.data()));
+  // OpenEXR addresses pixel (x, y) of the data window at base + x * xs + y * ys.
+  const ptrdiff_t ox = img.display_width != 0 ? img.origin_x : 0,
+                  oy = img.display_width != 0 ? img.origin_y : 0;
   const size_t xs = 3 * sizeof(float), ys = xs * img.width;
+  char* base =
+      reinterpret_cast<char*>(const_cast<float*>(img.rgb.data())) - ox * ptrdiff_t(xs) - oy * ptrdiff_t(ys);
   fb.insert("R", Imf::Slice(Imf::FLOAT, base, xs, ys));
   fb.insert("G", Imf::Slice(Imf::FLOAT, base + sizeof(float), xs, ys));
   fb.insert("B", Imf::Slice(Imf::FLOAT, base + 2 * sizeof(float), xs, ys));
   auto plane = [&](const std::string& name, const std::vector<float>& data) {
-    char* p = reinterpret_cast<char*>(const_cast<float*>(data.data()));
+    char* p = reinterpret_cast<char*>(const_cast<float*>(data.data())) -
+              (ox + oy * ptrdiff_t(img.width)) * ptrdiff_t(sizeof(float));
     fb.insert(name, Imf::Slice(Imf::FLOAT, p, sizeof(float), sizeof(float) * img.width));
   };
   if (!img.alpha.empty()) plane("A", img.alpha);
@@ -109,6 +123,13 @@ Image read_exr(const fs::path& path, ImageMetadata* meta) {
     }
     file.setFrameBuffer(fb);
     file.readPixels(dw.min.y, dw.max.y);
+    const Imath::Box2i disp = file.header().displayWindow();
+    if (dw != disp) {
+      img.origin_x = dw.min.x - disp.min.x;
+      img.origin_y = dw.min.y - disp.min.y;
+      img.display_width = disp.max.x - disp.min.x + 1;
+      img.display_height = disp.max.y - disp.min.y + 1;
+    }
     if (meta) {
       meta->clear();
       for (auto it = file.header().begin(); it != file.header().end(); ++it) {

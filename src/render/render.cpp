@@ -55,6 +55,20 @@ IntegratorSettings resolve_settings(const Scene& scene, const RenderOptions& opt
   if (options.noise > 0.0 && options.deep_samples > 0)
     throw Error("adaptive sampling (noise target) cannot make a deep image");
   if (options.noise_bin < 1 || options.noise_bin > 1024) throw Error("noise bin must be between 1 and 1024");
+  if (options.noise > 0.0 && (options.region || options.sample_start != 0))
+    throw Error(
+        "adaptive sampling (noise target) plans its passes over the whole image and all its samples "
+        "(no region, no sample range)");
+  if (options.deep_samples > 0 && (options.region || options.sample_start != 0))
+    throw Error("a deep image is made of the whole image and all its samples (no region, no sample range)");
+  if (options.sample_start < 0 || int64_t(options.sample_start) + settings.spp > int64_t(kMaxSpp))
+    throw Error(fmt::format("sample range: the first sample must be >= 0 and the last below {}", kMaxSpp));
+  if (const auto& r = options.region; r && !(0 <= r->x0 && r->x0 < r->x1 && r->x1 <= scene.camera.width &&
+                                             0 <= r->y0 && r->y0 < r->y1 && r->y1 <= scene.camera.height))
+    throw Error(
+        fmt::format("region {},{},{},{} is not a window inside the {}x{} image (x0,y0,x1,y1: "
+                    "0 <= x0 < x1 <= width, 0 <= y0 < y1 <= height)",
+                    r->x0, r->y0, r->x1, r->y1, scene.camera.width, scene.camera.height));
   if (options.deep_samples < 0 || options.deep_samples > kMaxDeepSamples)
     throw Error(fmt::format("deep samples must be between 1 and {} (0: no deep image)", kMaxDeepSamples));
   return settings;
@@ -75,6 +89,8 @@ nlohmann::json resolved_block(const IntegratorSettings& settings, const Integrat
 // (reused from pixel to pixel by one thread) and where its deep samples go.
 struct PixelTargets {
   Film& film;
+  int x0 = 0, y0 = 0;    // the film's first pixel in the image (a region)
+  int sample_start = 0;  // sample s of a pass is sample sample_start + s of the pixel
   const FilmLayers& layers;
   int deep_samples = 0;                               // 0: no deep image
   std::vector<std::vector<DeepSample>>* deep_pixels;  // per pixel, when deep_samples > 0
@@ -94,6 +110,8 @@ int64_t render_pixel(const Integrator& integrator, const PinholeCamera& camera,
   int64_t bad = 0;
   thread_local std::vector<DeepSegment> segments, sample_segments;
   segments.clear();
+  s0 += to.sample_start;
+  s1 += to.sample_start;
   for (int s = s0; s < s1; ++s) {
     Rng rng = Rng::for_sample(settings.seed, uint32_t(x), uint32_t(y), uint64_t(s));
     double jx = ux + s * kR2a1, jy = uy + s * kR2a2;
@@ -105,16 +123,16 @@ int64_t render_pixel(const Integrator& integrator, const PinholeCamera& camera,
     if (to.deep_samples > 0) sample.deep = &sample_segments;
     const uint64_t rng_start = rng.state();
     const Rgb L = integrator.Li(camera.generate_ray(x + jx, y + jy), rng, &sample);
-    const double* rgb = to.film.sums(0, x, y);
+    const double* rgb = to.film.sums(0, x - to.x0, y - to.y0);
     const double before = to.adaptive_layer >= 0 ? 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2] : 0.0;
-    if (!to.layers.add(to.film, x, y, L, sample)) {
+    if (!to.layers.add(to.film, x - to.x0, y - to.y0, L, sample)) {
       ++bad;
       continue;  // a dropped sample adds nothing to the deep pixel either
     }
     if (to.adaptive_layer >= 0) {  // the luminance the film took (less a transparent film's background)
       const double lum = 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2] - before;
       const double a[kAdaptiveChannels] = {lum * lum, double(rng.draws_since(rng_start))};
-      to.film.add(to.adaptive_layer, x, y, a);
+      to.film.add(to.adaptive_layer, x - to.x0, y - to.y0, a);
     }
     segments.insert(segments.end(), sample_segments.begin(), sample_segments.end());
   }
@@ -152,7 +170,7 @@ struct PassContext {
   const IntegratorSettings& settings;
   const RenderOptions& options;
   const PixelTargets& targets;
-  int width = 0, height = 0;
+  Region window;                 // the pixels rendered
   std::function<bool()> stop;    // cancelled, or past the time budget
   std::atomic<int64_t> done{0};  // pixel samples finished (over all passes)
   int64_t total = 0;             // pixel samples to take
@@ -165,13 +183,14 @@ struct PassContext {
 // Samples [s0, s1) of every pixel, tile by tile over oneTBB. Returns false when stopped part-way (the
 // film then holds part of the pass).
 bool render_pass(PassContext& pc, tbb::task_arena& arena, int s0, int s1) {
-  const int ts = pc.options.tile_size, W = pc.width, H = pc.height;
+  const int ts = pc.options.tile_size, X0 = pc.window.x0, Y0 = pc.window.y0;
+  const int W = pc.window.x1 - X0, H = pc.window.y1 - Y0;
   const int tiles_x = (W + ts - 1) / ts, tiles_y = (H + ts - 1) / ts;
   std::atomic<bool> stopped{false};
   std::atomic<int64_t> bad{0};
   auto render_tile = [&](int64_t tile) {
-    const int x0 = int(tile % tiles_x) * ts, y0 = int(tile / tiles_x) * ts;
-    const int x1 = std::min(x0 + ts, W), y1 = std::min(y0 + ts, H);
+    const int x0 = X0 + int(tile % tiles_x) * ts, y0 = Y0 + int(tile / tiles_x) * ts;
+    const int x1 = std::min(x0 + ts, X0 + W), y1 = std::min(y0 + ts, Y0 + H);
     int64_t tile_bad = 0, tile_samples = 0;
     for (int y = y0; y < y1; ++y) {
       // Stay responsive inside long tiles: the pass is abandoned.
@@ -182,8 +201,8 @@ bool render_pass(PassContext& pc, tbb::task_arena& arena, int s0, int s1) {
       for (int x = x0; x < x1; ++x) {
         int a = s0, b = s1;
         if (pc.target) {
-          a = int(pc.targets.film.samples(x, y));
-          b = int((*pc.target)[size_t(y) * size_t(W) + size_t(x)]);
+          a = int(pc.targets.film.samples(x - X0, y - Y0));
+          b = int((*pc.target)[size_t(y - Y0) * size_t(W) + size_t(x - X0)]);
         }
         tile_bad += render_pixel(pc.integrator, pc.camera, pc.settings, x, y, a, b, pc.targets);
         tile_samples += b - a;
@@ -219,6 +238,7 @@ ImageMetadata render_metadata(const Scene& scene, const RenderResult& result, co
       {"nimbus/integrator", result.integrator},
       {"nimbus/spp", std::to_string(result.spp)},
       {"nimbus/spp_requested", std::to_string(result.spp_requested)},
+      {"nimbus/sample_start", std::to_string(result.sample_start)},
       {"nimbus/seed", std::to_string(result.seed)},
       {"nimbus/max_events", result.settings.value("max_events", nlohmann::json(0)).dump()},
       {"nimbus/integrator_settings", result.settings.dump()},
@@ -262,7 +282,9 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
   result.spp_requested = settings.spp;
   result.seed = settings.seed;
   result.noise_target = options.noise;
-  const int W = scene.camera.width, H = scene.camera.height;
+  result.sample_start = options.sample_start;
+  const Region window = options.region.value_or(Region{0, 0, scene.camera.width, scene.camera.height});
+  const int W = window.x1 - window.x0, H = window.y1 - window.y0;
   Film film(W, H);
   FilmSettings film_settings = scene.film;
   if (options.layers) film_settings.layers = *options.layers;
@@ -284,17 +306,22 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
           fmt::format("resume: the image has {} spp, more than the {} asked for", done, settings.spp));
   }
   std::vector<std::vector<DeepSample>> deep_pixels(options.deep_samples > 0 ? size_t(W) * size_t(H) : 0);
-  const PixelTargets targets{film, layers, options.deep_samples, &deep_pixels, adaptive_layer};
+  const PixelTargets targets{
+      film,         window.x0,     window.y0, options.sample_start, layers, options.deep_samples,
+      &deep_pixels, adaptive_layer};
 
   bool first = true;
   auto cancelled = [&] { return options.cancel && options.cancel->load(std::memory_order_relaxed); };
   auto over_time = [&] {
     return options.time_limit > 0.0 && !first && seconds_since(start) > options.time_limit;
   };
-  PassContext pc{*integrator, context->camera,
-                 settings,    options,
-                 targets,     W,
-                 H,           [&] { return cancelled() || over_time(); }};
+  PassContext pc{*integrator,
+                 context->camera,
+                 settings,
+                 options,
+                 targets,
+                 window,
+                 [&] { return cancelled() || over_time(); }};
   pc.total = int64_t(W) * H * (settings.spp - done);
   const bool stoppable = options.cancel || options.time_limit > 0.0;
   double seconds_per_spp = 0.0;
@@ -358,12 +385,21 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
 
   result.spp = done;
   result.image = layers.resolve(film);
+  if (options.region) {
+    result.image.origin_x = window.x0;
+    result.image.origin_y = window.y0;
+    result.image.display_width = scene.camera.width;
+    result.image.display_height = scene.camera.height;
+  }
   if (options.deep_samples > 0 && done == settings.spp) result.deep = assemble_deep(W, H, deep_pixels);
   if (options.deep_samples == 0) result.state = film.state(done);
   result.nonfinite_samples = pc.nonfinite;
   result.seconds = seconds_since(start);
   result.settings = resolved_block(settings, *integrator);
   result.metadata = render_metadata(scene, result, film_settings);
+  if (options.region)
+    result.metadata.emplace_back("nimbus/region",
+                                 fmt::format("{},{},{},{}", window.x0, window.y0, window.x1, window.y1));
   return result;
 }
 

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <vector>
@@ -50,6 +51,18 @@ std::vector<double> parse_number_list(const std::string& what, const std::string
 
 std::string phase_table_dir() {
   if (const char* d = std::getenv("NIMBUS_DATA_DIR"); d && *d) return std::string(d) + "/phase";
+  // Installed (cmake --install --prefix P): P/share/nimbus/phase beside P/bin/nimbus, or where the build
+  // configured the prefix.
+  std::error_code ec;
+  const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  if (!ec) {
+    const std::filesystem::path dir = exe.parent_path().parent_path() / "share" / "nimbus" / "phase";
+    if (std::filesystem::is_directory(dir, ec)) return dir.string();
+  }
+#ifdef NIMBUS_INSTALL_DATA_DIR
+  if (std::filesystem::is_directory(NIMBUS_INSTALL_DATA_DIR "/phase", ec))
+    return NIMBUS_INSTALL_DATA_DIR "/phase";
+#endif
   return std::string(NIMBUS_SOURCE_DIR) + "/data/phase";
 }
 
@@ -102,6 +115,10 @@ Phase parse_phase_spec(const std::string& spec) {
     return make_gauss_phase(t);
   }
   if (kind == "mie") {
+    // A path (holds '/' or ends in .csv): that file; otherwise a table of phase_table_dir().
+    if (args.find('/') != std::string::npos ||
+        (args.size() > 4 && args.compare(args.size() - 4, 4, ".csv") == 0))
+      return load_phase_table(std::filesystem::path(args).stem().string(), args);
     if (args.empty() ||
         args.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-.") !=
             std::string::npos ||
@@ -109,8 +126,8 @@ Phase parse_phase_spec(const std::string& spec) {
       throw Error(fmt::format("phase '{}': mie needs a table name of letters, digits, '_', '-', '.'", spec));
     return load_phase_table(args, phase_table_dir() + "/" + args + ".csv");
   }
-  throw Error(
-      fmt::format("phase '{}': unknown type (use iso, hg:G, dhg:G1,G2,W, gauss:THETA2 or mie:NAME)", spec));
+  throw Error(fmt::format(
+      "phase '{}': unknown type (use iso, hg:G, dhg:G1,G2,W, gauss:THETA2, mie:NAME or mie:FILE.csv)", spec));
 }
 
 }  // namespace nimbus

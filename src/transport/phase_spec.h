@@ -1,5 +1,6 @@
 // Phase functions from short command-line specs: `iso`, `hg:G`, `dhg:G1,G2,W`, `gauss:THETA2`,
-// `mie:NAME` (the table data/phase/NAME.csv under $NIMBUS_DATA_DIR, else under the source tree).
+// `mie:NAME` (the table phase/NAME.csv under $NIMBUS_DATA_DIR, else under the installed share/nimbus,
+// else data/phase/NAME.csv of the source tree) or `mie:PATH` (a path with '/' or ending in .csv: that file).
 #pragma once
 
 #include <string>
@@ -19,7 +20,9 @@ Phase parse_phase_spec(const std::string& spec);
 // starting with '#' are skipped) as a normalised TabulatedPhase.
 TabulatedPhase load_phase_table(const std::string& name, const std::string& path);
 
-// The directory holding phase tables: $NIMBUS_DATA_DIR/phase if set, else NIMBUS_SOURCE_DIR/data/phase.
+// The directory holding phase tables: $NIMBUS_DATA_DIR/phase if set, else the installed
+// PREFIX/share/nimbus/phase when it exists (PREFIX: the program's bin/.., then the configured install
+// prefix), else NIMBUS_SOURCE_DIR/data/phase.
 std::string phase_table_dir();
 
 }  // namespace nimbus

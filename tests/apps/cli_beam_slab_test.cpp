@@ -12,6 +12,7 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <vector>
 
 namespace {
 
@@ -50,7 +51,7 @@ TEST(CliBeam, WritesTheDocumentedCsv) {
   std::ifstream in(out);
   std::string line;
   std::getline(in, line);
-  EXPECT_EQ(line, "model,depth,quantity,lo,hi,value,stderr");
+  EXPECT_EQ(line, "model,depth,quantity,lo,hi,value,stderr,bin_unit,value_unit");
   std::map<std::string, int> rows_per_model;
   std::set<std::string> quantities;
   while (std::getline(in, line)) {
@@ -105,7 +106,8 @@ TEST(CliBeam, BadArgumentsExitWithCode2AndAMessage) {
       {"beam --phase hg:abc --albedo 0.9" + base, "not a number"},
       {"beam --phase dhg:0.9,0.1 --albedo 0.9" + base, "expected 3"},
       {"beam --phase mie:no_such_table --albedo 0.9" + base, "cannot open"},
-      {"beam --phase mie:../x --albedo 0.9" + base, "table name"},
+      {"beam --phase mie:../x --albedo 0.9" + base, "cannot open"},  // a path: that file
+      {"beam --phase mie:a\\ b --albedo 0.9" + base, "table name"},
       {"beam --phase hg:0.9 --albedo -0.1" + base, "albedo"},
       {"beam --phase hg:0.9 --albedo 1.5" + base, "albedo"},
       {"beam --phase hg:0.9 --albedo 0.9 --depths 3,1", "increase"},
@@ -143,8 +145,43 @@ TEST(CliSlab, PrintsTheFiveTotalsThatBalance) {
   const CliRun c =
       run("slab --mu-s 100 --mu-a 0.1 --g 0.9 --thickness 0.1 --photons 500 --csv --angle-bins 3 --r-bins 2");
   ASSERT_EQ(c.rc, 0) << c.out;
-  EXPECT_NE(c.out.find("side,quantity,lo,hi,value,stderr"), std::string::npos);
+  EXPECT_NE(c.out.find("side,quantity,lo,hi,value,stderr,bin_unit,value_unit"), std::string::npos);
   EXPECT_NE(c.out.find("transmit,radial,"), std::string::npos);
+}
+
+TEST(CliSlab, TakesEveryPhaseFunctionBeamTakes) {
+  // --g G is --phase hg:G: the same photons, the same numbers.
+  const std::string slab = "slab --mu-s 100 --mu-a 0.1 --thickness 0.1 --photons 400 ";
+  const CliRun g = run(slab + "--g 0.9"), hg = run(slab + "--phase hg:0.9");
+  ASSERT_EQ(g.rc, 0) << g.out;
+  EXPECT_EQ(g.out, hg.out);
+  // The other kinds run and conserve energy; a table by path (mie:FILE.csv) as well as by name.
+  const auto table = temp_dir() / "my_mie.csv";
+  std::filesystem::copy_file(
+      std::filesystem::path(NIMBUS_SOURCE_DIR) / "data" / "phase" / "cloud_mie_550nm.csv", table,
+      std::filesystem::copy_options::overwrite_existing);
+  for (const std::string phase : std::vector<std::string>{"iso", "dhg:0.9,-0.3,0.8", "gauss:0.01",
+                                                          "mie:cloud_mie_550nm", "mie:" + table.string()}) {
+    const CliRun r = run(slab + "--phase " + phase);
+    ASSERT_EQ(r.rc, 0) << phase << ": " << r.out;
+    std::stringstream ss(r.out);
+    std::map<std::string, double> v;
+    std::string name;
+    double value, err;
+    while (ss >> name >> value >> err) v[name] = value;
+    EXPECT_NEAR(v["specular"] + v["diffuse_reflectance"] + v["transmittance"] + v["absorbed"], 1.0, 1e-6)
+        << phase;
+  }
+  EXPECT_EQ(
+      run("beam --phase mie:" + table.string() + " --albedo 0.9 --depths 1 --photons 200 --models dolin").rc,
+      0);
+  // Both, neither, or a bad spec: exit 2 naming the option.
+  for (const std::string bad :
+       {"--g 0.5 --phase iso", "", "--phase hg:2", "--phase mie:/nonexistent/t.csv"}) {
+    const CliRun r = run(slab + bad);
+    EXPECT_EQ(r.rc, 2) << bad << ": " << r.out;
+    EXPECT_NE(r.out.find("--"), std::string::npos) << r.out;
+  }
 }
 
 }  // namespace

@@ -96,7 +96,7 @@ TEST(CliTime, BeamAddsDelayRowsForMcAndMfs) {
   std::string line;
   while (std::getline(ss, line)) {
     const auto v = split(line);
-    if (v.size() == 7 && v[2].rfind("delay", 0) == 0) ++count[v[0] + ":" + v[2]];
+    if (v.size() == 9 && v[2].rfind("delay", 0) == 0) ++count[v[0] + ":" + v[2]];
   }
   for (const char* m : {"mc", "mfs"}) {
     EXPECT_EQ(count[std::string(m) + ":delay"], 2 * 3) << m;  // two bins and the tail, per depth

@@ -1,0 +1,86 @@
+#!/usr/bin/env bash
+# make farm-test: a one-node Slurm cluster on this machine (cluster.sh, as root), then
+#   1. a 4-frame volume sequence as a job array: every frame equals the single-machine render;
+#   2. one frame as 2x2 tiles times 2 sample ranges plus a dependent merge job: equals the one render
+#      (tiles bit for bit; the ranges to the double's rounding: docs/cli.md);
+#   3. a task killed midway (scancel: SIGTERM) leaves a partial image; the re-submission resumes it and
+#      the frame equals the one render bit for bit.
+# The daemons are stopped on every exit (trap). Usage: farm_test.sh [BUILD_DIR]
+set -euo pipefail
+root=$(cd "$(dirname "$0")/../.." && pwd)
+build=$(realpath "${1:-$root/build}")
+export NIMBUS=$build/bin/nimbus
+farm=$root/scripts/farm
+work=$(mktemp -d /tmp/nimbus_farm_test.XXXXXX)
+cleanup() {
+  "$farm/cluster.sh" stop "$work/cluster" || true
+  rm -rf "$work"
+}
+trap cleanup EXIT INT TERM
+eval "$(timeout 60 "$farm/cluster.sh" start "$work/cluster")"
+
+wait_jobs() {  # waits (at most $2 s) until none of the job ids in $1 is queued or running
+  for _ in $(seq $((${2:-120} * 2))); do
+    [[ -z $(squeue -h -j "$1" 2>/dev/null) ]] && return 0
+    sleep 0.5
+  done
+  echo "farm_test: jobs $1 still running" >&2
+  squeue >&2
+  return 1
+}
+same() {  # same.exr reference.exr TOLERANCE: nimbus compare's largest relative error <= TOLERANCE
+  local j
+  j=$("$NIMBUS" compare "$1" "$2" --json)
+  python3 - "$j" "$3" "$1" <<'PY'
+import json, sys
+j = json.loads(sys.argv[1]); tol = float(sys.argv[2])
+ok = j["max_abs_rel_error"] <= tol and abs(j["mean_rel_error"]) <= tol and j["bins_used"] > 0
+print(f"farm_test: {sys.argv[3]}: max |rel error| {j['max_abs_rel_error']:.3g} over {j['bins_used']} pixels", "ok" if ok else "FAILED")
+sys.exit(0 if ok else 1)
+PY
+}
+
+cd "$work"
+mkdir -p local
+for f in 1 2 3 4; do cp "$root/fuzz/data/tiny.vdb" "cloud.000$f.vdb"; done
+cat > seq.json <<'JSON'
+{"camera": {"position": [0.25, -5, -0.25], "look_at": [0.25, 0, -0.25], "up": [0, 0, 1], "fov_y_deg": 35,
+            "width": 32, "height": 24},
+ "media": [{"shape": {"type": "vdb", "file": "cloud.$F4.vdb"}, "sigma_s": 4.0}],
+ "lights": [{"type": "directional", "direction": [1, 1, -1], "irradiance": 2.0},
+            {"type": "environment", "radiance": 0.2}],
+ "integrator": {"type": "pathtrace", "spp": 8}}
+JSON
+
+echo "== 1. a 4-frame sequence, one frame per task"
+jid=$("$farm/submit.sh" sequence seq.json 1-4 'out/seq.$F4.exr' -- --threads 2 --set 'media.0.phase={"type": "hg", "g": 0.5}')
+wait_jobs "$jid"
+"$NIMBUS" render seq.json --quiet --frames 1-4 -o 'local/seq.$F4.exr' --set 'media.0.phase={"type": "hg", "g": 0.5}'
+for f in 0001 0002 0003 0004; do same "out/seq.$f.exr" "local/seq.$f.exr" 0; done
+
+echo "== 2. one frame as 2x2 tiles x 2 sample ranges, and a merge job"
+sed 's/cloud.$F4.vdb/cloud.0001.vdb/' seq.json > one.json
+ids=$("$farm/submit.sh" split one.json split/frame.exr 2 2 2 8)
+wait_jobs "$(echo $ids | tr ' ' ',')"
+"$NIMBUS" render one.json --quiet -o local/one.exr
+ls split/frame.parts/part_*.exr | wc -l | grep -qx 8
+same split/frame.exr local/one.exr 1e-6
+
+echo "== 3. a task killed midway, then re-submitted"
+sed 's/"spp": 8/"spp": 32768/' one.json > long.json
+jid=$("$farm/submit.sh" sequence long.json 1 'kill/long.$F.exr')
+for _ in $(seq 240); do  # until the task's nimbus renders (this one node is this machine), then 2 s more
+  pgrep -f -- "render --quiet $work/long.json" >/dev/null && break
+  sleep 0.25
+done
+sleep 2
+scancel "$jid"
+wait_jobs "$jid"
+[[ -f kill/long.1.partial.exr && ! -f kill/long.1.exr ]] || { echo "farm_test: no partial image after the kill" >&2; ls -R kill >&2; exit 1; }
+"$NIMBUS" info kill/long.1.partial.exr | grep '^nimbus/spp '
+jid=$("$farm/submit.sh" sequence long.json 1 'kill/long.$F.exr')
+wait_jobs "$jid" 300
+grep -h "task:" kill/logs/*.log
+"$NIMBUS" render long.json --quiet -o local/long.exr
+same kill/long.1.exr local/long.exr 0
+echo "farm_test: all passed"

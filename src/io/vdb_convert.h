@@ -1,0 +1,17 @@
+// OpenVDB to NanoVDB files (nimbus convert IN.vdb OUT.nvdb).
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace nimbus {
+
+// Writes the float grids of the OpenVDB file `in` (`grids`: those names; empty: every float grid) as a
+// NanoVDB file `out` (ZIP-compressed, full statistics and checksum), atomically. Each grid is read and
+// checked as load_density_grid reads a .vdb. Returns the names written. nimbus::Error names the file.
+std::vector<std::string> convert_vdb_to_nvdb(const std::filesystem::path& in,
+                                             const std::filesystem::path& out,
+                                             const std::vector<std::string>& grids = {});
+
+}  // namespace nimbus

@@ -1,0 +1,75 @@
+// nimbus convert IN.vdb OUT.nvdb: the NanoVDB file holds the same grids (same voxels, values, transform:
+// `nimbus info` says the same) and renders the same image; bad conversions exit 2 with nothing written.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "nimbus/image.h"
+#include "support/scratch_dir.h"
+
+namespace nimbus {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string run_out(const std::string& args, int* rc) {
+  std::string out;
+  FILE* p = popen((std::string(NIMBUS_CLI) + " " + args + " 2>&1").c_str(), "r");
+  char buf[4096];
+  size_t n;
+  while (p && (n = fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, n);
+  const int status = p ? pclose(p) : -1;
+  *rc = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return out;
+}
+
+std::string after_first_line(const std::string& s) { return s.substr(s.find('\n') + 1); }
+
+TEST(ConvertCli, VdbBecomesAnEquivalentNvdb) {
+  const test::ScratchDir dir("convert_vdb");
+  const fs::path vdb = fs::path(NIMBUS_SOURCE_DIR) / "fuzz" / "data" / "tiny.vdb";
+  int rc = -1;
+  run_out("convert " + vdb.string() + " " + (dir / "t.nvdb").string(), &rc);
+  ASSERT_EQ(rc, 0);
+  const std::string a = run_out("info " + vdb.string(), &rc),
+                    b = run_out("info " + (dir / "t.nvdb").string(), &rc);
+  ASSERT_EQ(rc, 0) << b;
+  EXPECT_EQ(after_first_line(a), after_first_line(b));
+  EXPECT_NE(b.find("active voxels 25"), std::string::npos) << b;
+  // The same image from either file.
+  for (const char* f : {"a", "b"}) {
+    std::ofstream(dir / (std::string(f) + ".json"))
+        << R"({"camera": {"position": [0.25, -5, -0.25], "look_at": [0.25, 0, -0.25], "up": [0, 0, 1],
+          "fov_y_deg": 35, "width": 8, "height": 6},
+          "media": [{"shape": {"type": "vdb", "file": ")"
+        << (f[0] == 'a' ? vdb.string() : (dir / "t.nvdb").string()) << R"("}, "sigma_s": 4.0}],
+          "lights": [{"type": "directional", "direction": [1, 1, -1], "irradiance": 2.0}],
+          "integrator": {"type": "pathtrace", "spp": 2}})";
+    run_out("render --quiet " + (dir / (std::string(f) + ".json")).string() + " -o " +
+                (dir / (std::string(f) + ".exr")).string(),
+            &rc);
+    ASSERT_EQ(rc, 0);
+  }
+  const Image ia = read_exr(dir / "a.exr"), ib = read_exr(dir / "b.exr");
+  ASSERT_EQ(ia.rgb.size(), ib.rgb.size());
+  EXPECT_EQ(0, std::memcmp(ia.rgb.data(), ib.rgb.data(), ia.rgb.size() * sizeof(float)));
+  // Not a .vdb, no such grid, an image to a volume: exit 2 naming the file, nothing written.
+  for (const std::string& bad : {"convert " + (dir / "a.exr").string() + " " + (dir / "x.nvdb").string(),
+                                 "convert " + vdb.string() + " " + (dir / "x.nvdb").string() + " --grid nope",
+                                 "convert " + (dir / "t.nvdb").string() + " " + (dir / "x.nvdb").string(),
+                                 "convert " + vdb.string() + " " + (dir / "x.png").string()}) {
+    const std::string err = run_out(bad, &rc);
+    EXPECT_EQ(rc, 2) << bad << ": " << err;
+    EXPECT_NE(err.find("nimbus: error: "), std::string::npos) << err;
+  }
+  EXPECT_FALSE(fs::exists(dir / "x.nvdb"));
+  EXPECT_FALSE(fs::exists(dir / "x.png"));
+}
+
+}  // namespace
+}  // namespace nimbus
