@@ -87,6 +87,8 @@ py::dict result_dict(const RenderResult& r) {
   d["seconds"] = r.seconds;
   d["time_limited"] = r.time_limited;
   d["nonfinite_samples"] = r.nonfinite_samples;
+  d["spp_mean"] = r.spp_mean;
+  d["noise_estimate"] = r.noise_estimate;
   d["settings"] = from_json(r.settings);
   py::dict meta;
   for (const auto& [k, v] : r.metadata) meta[py::str(k)] = v;
@@ -124,7 +126,7 @@ std::optional<py::error_already_set> wait_for_render(RenderRun& run, const py::o
 py::dict render_py(const py::object& scene_obj, std::optional<int> spp, int threads,
                    std::optional<std::string> integrator, std::optional<uint64_t> seed,
                    std::optional<std::vector<std::string>> layers, const py::object& progress,
-                   std::optional<double> time_limit) {
+                   std::optional<double> time_limit, std::optional<double> noise, int noise_bin) {
   const std::shared_ptr<Scene> scene = as_scene(scene_obj);
   RenderRun run;
   RenderOptions options;
@@ -134,6 +136,10 @@ py::dict render_py(const py::object& scene_obj, std::optional<int> spp, int thre
   options.layers = layers;
   options.threads = threads;
   options.time_limit = time_limit.value_or(0.0);
+  options.noise = noise.value_or(0.0);
+  options.noise_bin = noise_bin;
+  // As render --noise: without an spp, pixels may take up to 4096 samples.
+  if (options.noise > 0.0 && !spp) options.spp = 4096;
   options.cancel = &run.cancel;
   // Called from worker threads, possibly out of order: keep the largest count.
   options.progress = [&run](int64_t done, int64_t total, int64_t) {
@@ -176,7 +182,8 @@ py::dict render_py(const py::object& scene_obj, std::optional<int> spp, int thre
 void init_render(py::module_& m) {
   m.def("render", &render_py, py::arg("scene"), py::arg("spp") = py::none(), py::arg("threads") = 0,
         py::arg("integrator") = py::none(), py::arg("seed") = py::none(), py::arg("layers") = py::none(),
-        py::arg("progress") = py::none(), py::arg("time_limit") = py::none(),
+        py::arg("progress") = py::none(), py::arg("time_limit") = py::none(), py::arg("noise") = py::none(),
+        py::arg("noise_bin") = 4,
         R"(Renders a scene: a nimbus.Scene, a dict (scene_from_dict) or a path (load_scene).
 
 spp, integrator, seed: override the scene's integrator block (another integrator than the scene's
@@ -186,6 +193,9 @@ layers: compositing layers to keep besides RGBA, e.g. ['depth', 'direct'] (names
 progress: called as progress(done, total) with the pixel samples taken and to take, from the calling
   thread, at most every 50 ms and once at the end.
 time_limit: a budget in seconds; the render takes whole passes (1, 2, 4, ... spp) while they fit.
+noise: adaptive sampling, as `nimbus render --noise`: passes until the estimated binned relative RMSE
+  (noise_bin x noise_bin bins, bins darker than 5 % of the mean left out) is at most this; spp is then the
+  most samples a pixel may take (default 4096).
 
 The GIL is released while rendering. Ctrl-C (KeyboardInterrupt), or an exception raised by the
 progress callback, stops the render within a tile and propagates.
@@ -193,7 +203,7 @@ progress callback, stops the render within a tile and propagates.
 Returns a dict: 'rgba' float32 H x W x 4 (linear, premultiplied alpha, row 0 the top), 'layers'
 {name: float32 H x W (depth [world units], samples) or H x W x 3}, and the resolved settings:
 'width', 'height', 'integrator', 'spp' (reached), 'spp_requested', 'seed', 'seconds' (wall time),
-'time_limited', 'nonfinite_samples', 'settings' (the integrator block as rendered, auto choices
+'time_limited', 'nonfinite_samples', 'spp_mean', 'noise_estimate' (adaptive sampling), 'settings' (the integrator block as rendered, auto choices
 resolved), 'metadata' (what an EXR header would carry).)");
   m.def("integrator_names", &integrator_names, "Names of the integrators.");
   m.def("layer_names", &film_layer_names, "Names of the compositing layers a render can keep.");

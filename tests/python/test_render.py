@@ -71,6 +71,18 @@ class RenderMatchesCli(unittest.TestCase):
         centre = r["layers"]["depth"][8, 12]
         self.assertTrue(3.0 < centre < 5.0, centre)  # the sphere's near side lies 3 from the camera
 
+    def test_adaptive_noise_equals_cli(self):
+        doc = small_scene("pathtrace")
+        exr = self.cli_render(doc, "--noise", "0.2", "--spp", "256")
+        r = nimbus.render(doc, noise=0.2, spp=256, layers=["samples"])
+        self.assertTrue(np.array_equal(r["rgba"], exr["rgba"]))
+        self.assertLessEqual(r["noise_estimate"], 0.2)
+        self.assertGreater(r["noise_estimate"], 0.0)
+        n = r["layers"]["samples"]
+        self.assertEqual(float(n.max()), float(r["spp"]))
+        self.assertGreaterEqual(float(n.min()), 8.0)
+        self.assertAlmostEqual(r["spp_mean"], float(n.mean()), places=4)
+
     def test_write_image_round_trip(self):
         r = nimbus.render(small_scene(spp=1))
         path = os.path.join(self.dir, "w.exr")
