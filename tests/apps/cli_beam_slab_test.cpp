@@ -14,25 +14,12 @@
 #include <string>
 #include <vector>
 
+#include "support/cli.h"
+
 namespace {
 
-struct CliRun {
-  int rc = -1;
-  std::string out;  // stdout and stderr together
-};
-
-CliRun run(const std::string& args) {
-  CliRun r;
-  const std::string cmd = std::string(NIMBUS_CLI) + " " + args + " 2>&1";
-  FILE* p = popen(cmd.c_str(), "r");
-  if (!p) return r;
-  char buf[4096];
-  size_t n;
-  while ((n = fread(buf, 1, sizeof buf, p)) > 0) r.out.append(buf, n);
-  const int status = pclose(p);
-  r.rc = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
+using nimbus::test::CliRun;
+using nimbus::test::run_cli;
 
 std::filesystem::path temp_dir() {
   auto d = std::filesystem::temp_directory_path() / ("nimbus_cli_test_" + std::to_string(::getpid()));
@@ -43,10 +30,10 @@ std::filesystem::path temp_dir() {
 TEST(CliBeam, WritesTheDocumentedCsv) {
   const auto dir = temp_dir();
   const auto out = dir / "beam.csv";
-  const CliRun r =
-      run("beam --phase hg:0.9 --albedo 0.99 --depths 1,3 --photons 2000 --theta-edges 0,0.01,0.1,1,3.14159 "
-          "--r-edges 0,0.1,1,10 -o " +
-          out.string());
+  const CliRun r = run_cli(
+      "beam --phase hg:0.9 --albedo 0.99 --depths 1,3 --photons 2000 --theta-edges 0,0.01,0.1,1,3.14159 "
+      "--r-edges 0,0.1,1,10 -o " +
+      out.string());
   ASSERT_EQ(r.rc, 0) << r.out;
   std::ifstream in(out);
   std::string line;
@@ -86,12 +73,12 @@ TEST(CliBeam, WritesTheDocumentedCsv) {
 }
 
 TEST(CliBeam, ModelsSubsetSlabAndSeed) {
-  const CliRun a =
-      run("beam --phase gauss:0.01 --albedo 0.9 --depths 1 --geometry slab:2 --n 1.33 --photons 500 "
-          "--models mc --theta-edges 0,0.1,3.14159 --r-edges 0,1 --seed 7");
-  const CliRun b =
-      run("beam --phase gauss:0.01 --albedo 0.9 --depths 1 --geometry slab:2 --n 1.33 --photons 500 "
-          "--models mc --theta-edges 0,0.1,3.14159 --r-edges 0,1 --seed 7");
+  const CliRun a = run_cli(
+      "beam --phase gauss:0.01 --albedo 0.9 --depths 1 --geometry slab:2 --n 1.33 --photons 500 "
+      "--models mc --theta-edges 0,0.1,3.14159 --r-edges 0,1 --seed 7");
+  const CliRun b = run_cli(
+      "beam --phase gauss:0.01 --albedo 0.9 --depths 1 --geometry slab:2 --n 1.33 --photons 500 "
+      "--models mc --theta-edges 0,0.1,3.14159 --r-edges 0,1 --seed 7");
   ASSERT_EQ(a.rc, 0) << a.out;
   EXPECT_EQ(a.out, b.out);
   EXPECT_EQ(a.out.find("gsa"), std::string::npos);
@@ -124,14 +111,14 @@ TEST(CliBeam, BadArgumentsExitWithCode2AndAMessage) {
       {"slab --mu-s 10 --mu-a 1 --g 0.9 --thickness 1 --n 0.5", "--n"},
   };
   for (const auto& [args, needle] : cases) {
-    const CliRun r = run(args);
+    const CliRun r = run_cli(args);
     EXPECT_EQ(r.rc, 2) << args << "\n" << r.out;
     EXPECT_NE(r.out.find(needle), std::string::npos) << args << "\n" << r.out;
   }
 }
 
 TEST(CliSlab, PrintsTheFiveTotalsThatBalance) {
-  const CliRun r = run("slab --mu-s 100 --mu-a 0.1 --g 0.9 --thickness 0.1 --n 1.33 --photons 5000");
+  const CliRun r = run_cli("slab --mu-s 100 --mu-a 0.1 --g 0.9 --thickness 0.1 --n 1.33 --photons 5000");
   ASSERT_EQ(r.rc, 0) << r.out;
   std::stringstream ss(r.out);
   std::map<std::string, double> v;
@@ -142,8 +129,8 @@ TEST(CliSlab, PrintsTheFiveTotalsThatBalance) {
   EXPECT_NEAR(v["specular"], std::pow(0.33 / 2.33, 2), 1e-7);
   EXPECT_NEAR(v["specular"] + v["diffuse_reflectance"] + v["transmittance"] + v["absorbed"], 1.0, 1e-3);
   EXPECT_LE(v["unscattered_transmittance"], v["transmittance"]);
-  const CliRun c =
-      run("slab --mu-s 100 --mu-a 0.1 --g 0.9 --thickness 0.1 --photons 500 --csv --angle-bins 3 --r-bins 2");
+  const CliRun c = run_cli(
+      "slab --mu-s 100 --mu-a 0.1 --g 0.9 --thickness 0.1 --photons 500 --csv --angle-bins 3 --r-bins 2");
   ASSERT_EQ(c.rc, 0) << c.out;
   EXPECT_NE(c.out.find("side,quantity,lo,hi,value,stderr,bin_unit,value_unit"), std::string::npos);
   EXPECT_NE(c.out.find("transmit,radial,"), std::string::npos);
@@ -152,7 +139,7 @@ TEST(CliSlab, PrintsTheFiveTotalsThatBalance) {
 TEST(CliSlab, TakesEveryPhaseFunctionBeamTakes) {
   // --g G is --phase hg:G: the same photons, the same numbers.
   const std::string slab = "slab --mu-s 100 --mu-a 0.1 --thickness 0.1 --photons 400 ";
-  const CliRun g = run(slab + "--g 0.9"), hg = run(slab + "--phase hg:0.9");
+  const CliRun g = run_cli(slab + "--g 0.9"), hg = run_cli(slab + "--phase hg:0.9");
   ASSERT_EQ(g.rc, 0) << g.out;
   EXPECT_EQ(g.out, hg.out);
   // The other kinds run and conserve energy; a table by path (mie:FILE.csv) as well as by name.
@@ -160,9 +147,9 @@ TEST(CliSlab, TakesEveryPhaseFunctionBeamTakes) {
   std::filesystem::copy_file(
       std::filesystem::path(NIMBUS_SOURCE_DIR) / "data" / "phase" / "cloud_mie_550nm.csv", table,
       std::filesystem::copy_options::overwrite_existing);
-  for (const std::string phase : std::vector<std::string>{"iso", "dhg:0.9,-0.3,0.8", "gauss:0.01",
-                                                          "mie:cloud_mie_550nm", "mie:" + table.string()}) {
-    const CliRun r = run(slab + "--phase " + phase);
+  for (const std::string& phase : std::vector<std::string>{"iso", "dhg:0.9,-0.3,0.8", "gauss:0.01",
+                                                           "mie:cloud_mie_550nm", "mie:" + table.string()}) {
+    const CliRun r = run_cli(slab + "--phase " + phase);
     ASSERT_EQ(r.rc, 0) << phase << ": " << r.out;
     std::stringstream ss(r.out);
     std::map<std::string, double> v;
@@ -173,12 +160,13 @@ TEST(CliSlab, TakesEveryPhaseFunctionBeamTakes) {
         << phase;
   }
   EXPECT_EQ(
-      run("beam --phase mie:" + table.string() + " --albedo 0.9 --depths 1 --photons 200 --models dolin").rc,
+      run_cli("beam --phase mie:" + table.string() + " --albedo 0.9 --depths 1 --photons 200 --models dolin")
+          .rc,
       0);
   // Both, neither, or a bad spec: exit 2 naming the option.
   for (const std::string bad :
        {"--g 0.5 --phase iso", "", "--phase hg:2", "--phase mie:/nonexistent/t.csv"}) {
-    const CliRun r = run(slab + bad);
+    const CliRun r = run_cli(slab + bad);
     EXPECT_EQ(r.rc, 2) << bad << ": " << r.out;
     EXPECT_NE(r.out.find("--"), std::string::npos) << r.out;
   }

@@ -13,25 +13,12 @@
 #include <string>
 #include <vector>
 
+#include "support/cli.h"
+
 namespace {
 
-struct CliRun {
-  int rc = -1;
-  std::string out;  // stdout and stderr together
-};
-
-CliRun run(const std::string& args) {
-  CliRun r;
-  const std::string cmd = std::string(NIMBUS_CLI) + " " + args + " 2>&1";
-  FILE* p = popen(cmd.c_str(), "r");
-  if (!p) return r;
-  char buf[4096];
-  size_t n;
-  while ((n = fread(buf, 1, sizeof buf, p)) > 0) r.out.append(buf, n);
-  const int status = pclose(p);
-  r.rc = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
+using nimbus::test::CliRun;
+using nimbus::test::run_cli;
 
 std::filesystem::path temp_dir() {
   auto d = std::filesystem::temp_directory_path() / ("nimbus_cli_time_test_" + std::to_string(::getpid()));
@@ -50,10 +37,10 @@ std::vector<std::string> split(const std::string& line) {
 TEST(CliTime, SlabWritesTimeRowsThatSumToTheSteadyValues) {
   const auto dir = temp_dir();
   const auto out = dir / "time.csv";
-  const CliRun r =
-      run("slab --mu-s 1 --mu-a 0.1 --g 0.5 --thickness 1 --n 1.4 --photons 4000 --time-edges 1:3:4 "
-          "--time-csv " +
-          out.string());
+  const CliRun r = run_cli(
+      "slab --mu-s 1 --mu-a 0.1 --g 0.5 --thickness 1 --n 1.4 --photons 4000 --time-edges 1:3:4 "
+      "--time-csv " +
+      out.string());
   ASSERT_EQ(r.rc, 0) << r.out;
   std::map<std::string, double> steady;
   {
@@ -87,9 +74,9 @@ TEST(CliTime, SlabWritesTimeRowsThatSumToTheSteadyValues) {
 }
 
 TEST(CliTime, BeamAddsDelayRowsForMcAndMfs) {
-  const CliRun r =
-      run("beam --phase gauss:0.01 --albedo 0.99 --depths 0.5,1 --photons 2000 --models mc,mfs "
-          "--theta-edges 0,0.1,3.14159 --r-edges 0,1 --time-edges 0,0.001,0.01");
+  const CliRun r = run_cli(
+      "beam --phase gauss:0.01 --albedo 0.99 --depths 0.5,1 --photons 2000 --models mc,mfs "
+      "--theta-edges 0,0.1,3.14159 --r-edges 0,1 --time-edges 0,0.001,0.01");
   ASSERT_EQ(r.rc, 0) << r.out;
   std::map<std::string, int> count;
   std::stringstream ss(r.out);
@@ -113,11 +100,11 @@ TEST(CliTime, SlabBadTimeEdgesExitWithCode2NamingTheArgument) {
   const std::string slab =
       "slab --mu-s 1 --mu-a 0 --g 0 --thickness 1 --photons 100 --time-csv " + out.string();
   for (const char* bad : kBadEdges) {
-    const CliRun r = run(slab + " --time-edges=" + bad);
+    const CliRun r = run_cli(slab + " --time-edges=" + bad);
     EXPECT_EQ(r.rc, 2) << bad << ": " << r.out;
     EXPECT_NE(r.out.find("--time-edges"), std::string::npos) << bad << ": " << r.out;
   }
-  const CliRun r = run(slab);  // --time-csv without --time-edges
+  const CliRun r = run_cli(slab);  // --time-csv without --time-edges
   EXPECT_EQ(r.rc, 2) << r.out;
   EXPECT_FALSE(std::filesystem::exists(out));
   std::filesystem::remove_all(dir);
@@ -126,7 +113,7 @@ TEST(CliTime, SlabBadTimeEdgesExitWithCode2NamingTheArgument) {
 TEST(CliTime, BeamBadTimeEdgesExitWithCode2NamingTheArgument) {
   const std::string beam = "beam --phase hg:0.9 --albedo 0.9 --photons 100 --depths 1 --time-edges=";
   for (const char* bad : kBadEdges) {
-    const CliRun b = run(beam + bad);
+    const CliRun b = run_cli(beam + bad);
     EXPECT_EQ(b.rc, 2) << bad << ": " << b.out;
     EXPECT_NE(b.out.find("--time-edges"), std::string::npos) << bad << ": " << b.out;
   }
@@ -134,7 +121,7 @@ TEST(CliTime, BeamBadTimeEdgesExitWithCode2NamingTheArgument) {
   std::string depths = "0.1";
   for (int i = 2; i <= 100; ++i) depths += "," + std::to_string(0.1 * i);
   const CliRun m =
-      run("beam --phase hg:0.9 --albedo 0.9 --photons 100 --time-edges 0:1:100000 --depths " + depths);
+      run_cli("beam --phase hg:0.9 --albedo 0.9 --photons 100 --time-edges 0:1:100000 --depths " + depths);
   EXPECT_EQ(m.rc, 2) << m.out;
   EXPECT_NE(m.out.find("--time-edges"), std::string::npos) << m.out;
 }

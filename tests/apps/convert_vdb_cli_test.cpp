@@ -10,6 +10,7 @@
 #include <string>
 
 #include "nimbus/image.h"
+#include "support/cli.h"
 #include "support/scratch_dir.h"
 
 namespace nimbus {
@@ -17,28 +18,18 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string run_out(const std::string& args, int* rc) {
-  std::string out;
-  FILE* p = popen((std::string(NIMBUS_CLI) + " " + args + " 2>&1").c_str(), "r");
-  char buf[4096];
-  size_t n;
-  while (p && (n = fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, n);
-  const int status = p ? pclose(p) : -1;
-  *rc = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return out;
-}
+using test::run_cli;
 
 std::string after_first_line(const std::string& s) { return s.substr(s.find('\n') + 1); }
 
 TEST(ConvertCli, VdbBecomesAnEquivalentNvdb) {
   const test::ScratchDir dir("convert_vdb");
   const fs::path vdb = fs::path(NIMBUS_SOURCE_DIR) / "fuzz" / "data" / "tiny.vdb";
-  int rc = -1;
-  run_out("convert " + vdb.string() + " " + (dir / "t.nvdb").string(), &rc);
-  ASSERT_EQ(rc, 0);
-  const std::string a = run_out("info " + vdb.string(), &rc),
-                    b = run_out("info " + (dir / "t.nvdb").string(), &rc);
-  ASSERT_EQ(rc, 0) << b;
+  ASSERT_EQ(run_cli("convert " + vdb.string() + " " + (dir / "t.nvdb").string()).rc, 0);
+  const test::CliRun info_a = run_cli("info " + vdb.string()),
+                     info_b = run_cli("info " + (dir / "t.nvdb").string());
+  ASSERT_EQ(info_b.rc, 0) << info_b.out;
+  const std::string &a = info_a.out, &b = info_b.out;
   EXPECT_EQ(after_first_line(a), after_first_line(b));
   EXPECT_NE(b.find("active voxels 25"), std::string::npos) << b;
   // The same image from either file.
@@ -50,10 +41,10 @@ TEST(ConvertCli, VdbBecomesAnEquivalentNvdb) {
         << (f[0] == 'a' ? vdb.string() : (dir / "t.nvdb").string()) << R"("}, "sigma_s": 4.0}],
           "lights": [{"type": "directional", "direction": [1, 1, -1], "irradiance": 2.0}],
           "integrator": {"type": "pathtrace", "spp": 2}})";
-    run_out("render --quiet " + (dir / (std::string(f) + ".json")).string() + " -o " +
-                (dir / (std::string(f) + ".exr")).string(),
-            &rc);
-    ASSERT_EQ(rc, 0);
+    ASSERT_EQ(run_cli("render --quiet " + (dir / (std::string(f) + ".json")).string() + " -o " +
+                      (dir / (std::string(f) + ".exr")).string())
+                  .rc,
+              0);
   }
   const Image ia = read_exr(dir / "a.exr"), ib = read_exr(dir / "b.exr");
   ASSERT_EQ(ia.rgb.size(), ib.rgb.size());
@@ -63,8 +54,9 @@ TEST(ConvertCli, VdbBecomesAnEquivalentNvdb) {
                                  "convert " + vdb.string() + " " + (dir / "x.nvdb").string() + " --grid nope",
                                  "convert " + (dir / "t.nvdb").string() + " " + (dir / "x.nvdb").string(),
                                  "convert " + vdb.string() + " " + (dir / "x.png").string()}) {
-    const std::string err = run_out(bad, &rc);
-    EXPECT_EQ(rc, 2) << bad << ": " << err;
+    const test::CliRun r = run_cli(bad);
+    const std::string& err = r.out;
+    EXPECT_EQ(r.rc, 2) << bad << ": " << err;
     EXPECT_NE(err.find("nimbus: error: "), std::string::npos) << err;
   }
   EXPECT_FALSE(fs::exists(dir / "x.nvdb"));

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "io/vdb_test_util.h"
+#include "support/cli.h"
 
 namespace nimbus {
 namespace {
@@ -14,39 +15,27 @@ using test::kCloud;
 using test::kSmoke;
 using test::shared_volume;
 
-struct CliResult {
-  int status;
-  std::string out;
-};
-CliResult run_cli(const std::string& args) {
-  const std::string cmd = std::string(NIMBUS_CLI) + " " + args + " 2>&1";
-  FILE* p = ::popen(cmd.c_str(), "r");
-  std::string out;
-  char buf[4096];
-  while (size_t n = std::fread(buf, 1, sizeof(buf), p)) out.append(buf, n);
-  const int st = ::pclose(p);
-  return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, out};
-}
+using test::run_cli;
 
 TEST(VdbCli, InfoListsTheGrids) {
   NIMBUS_REQUIRE_FILE(shared_volume(kCloud));
   NIMBUS_REQUIRE_FILE(shared_volume(kSmoke));
-  CliResult r = run_cli("info " + shared_volume(kCloud).string());
-  EXPECT_EQ(r.status, 0) << r.out;
+  test::CliRun r = run_cli("info " + shared_volume(kCloud).string());
+  EXPECT_EQ(r.rc, 0) << r.out;
   EXPECT_NE(r.out.find("grid 0: density"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("415642"), std::string::npos);
   EXPECT_NE(r.out.find("[-66, -21, -90] .. [59, 64, 63]"), std::string::npos);
   EXPECT_NE(r.out.find("fog volume"), std::string::npos);
   r = run_cli("info " + shared_volume(kSmoke).string());
-  EXPECT_EQ(r.status, 0) << r.out;
+  EXPECT_EQ(r.rc, 0) << r.out;
   EXPECT_NE(r.out.find("(unnamed)"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("1049275"), std::string::npos);
   EXPECT_NE(r.out.find("[1, 2, 1] .. [111, 223, 112]"), std::string::npos);
   r = run_cli("info /nonexistent/cloud.vdb");
-  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.rc, 2);
   EXPECT_NE(r.out.find("nimbus: error: /nonexistent/cloud.vdb: no such file"), std::string::npos) << r.out;
   r = run_cli("info --help");
-  EXPECT_EQ(r.status, 0);
+  EXPECT_EQ(r.rc, 0);
   EXPECT_NE(r.out.find(".nvdb"), std::string::npos) << r.out;
 }
 

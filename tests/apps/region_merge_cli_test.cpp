@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "nimbus/image.h"
+#include "support/cli.h"
 #include "support/scratch_dir.h"
 
 namespace nimbus {
@@ -31,23 +32,9 @@ void write_scene(const fs::path& file, int spp) {
                       << spp << "}}";
 }
 
-int run(const std::string& args) {
-  const int status = std::system((std::string(NIMBUS_CLI) + " " + args).c_str());
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-std::string meta_value(const ImageMetadata& meta, const std::string& key) {
-  for (const auto& [k, v] : meta)
-    if (k == key) return v;
-  return "(missing)";
-}
+using test::meta_value;
+using test::run_cli_status;
+using test::slurp;
 
 bool same_bits(float a, float b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
@@ -80,9 +67,10 @@ TEST(RegionCli, CropEqualsTheFullRenderBitForBit) {
   const test::ScratchDir dir("region_crop");
   write_scene(dir / "s.json", 3);
   const std::string s = (dir / "s.json").string() + " --quiet ";
-  ASSERT_EQ(run("render " + s + "-o " + (dir / "full.exr").string()), 0);
+  ASSERT_EQ(run_cli_status("render " + s + "-o " + (dir / "full.exr").string()), 0);
   // An odd window, on one thread with small tiles: neither the tiling nor the threads matter.
-  ASSERT_EQ(run("render " + s + "--region 3,2,12,9 --threads 1 -o " + (dir / "crop.exr").string()), 0);
+  ASSERT_EQ(run_cli_status("render " + s + "--region 3,2,12,9 --threads 1 -o " + (dir / "crop.exr").string()),
+            0);
   ImageMetadata meta;
   const Image crop = read_exr(dir / "crop.exr", &meta);
   EXPECT_EQ(crop.width, 9);
@@ -94,8 +82,8 @@ TEST(RegionCli, CropEqualsTheFullRenderBitForBit) {
   EXPECT_EQ(meta_value(meta, "nimbus/region"), "3,2,12,9");
   expect_crop_of(dir / "crop.exr", dir / "full.exr");
   // A crop resumed to more samples is the crop of the render with as many.
-  ASSERT_EQ(run("render " + s + "--region 0,5,14,10 --spp 1 -o " + (dir / "r.exr").string()), 0);
-  ASSERT_EQ(run("render --quiet --resume " + (dir / "r.exr").string() + " --spp 3"), 0);
+  ASSERT_EQ(run_cli_status("render " + s + "--region 0,5,14,10 --spp 1 -o " + (dir / "r.exr").string()), 0);
+  ASSERT_EQ(run_cli_status("render --quiet --resume " + (dir / "r.exr").string() + " --spp 3"), 0);
   expect_crop_of(dir / "r.exr", dir / "full.exr");
 }
 
@@ -105,12 +93,12 @@ TEST(RegionCli, WindowOutsideTheImageIsRejected) {
   const std::string s = "render " + (dir / "s.json").string() + " --quiet -o " + (dir / "x.exr").string();
   for (const char* bad :
        {"0,0,15,10", "0,0,14,11", "5,5,5,8", "4,4,2,8", "-1,0,4,4", "1,2,3", "a,b,c,d", "0,0,4,4,5"}) {
-    EXPECT_EQ(run(s + " --region " + bad + " 2>" + (dir / "err.txt").string()), 2) << bad;
+    EXPECT_EQ(run_cli_status(s + " --region " + bad + " 2>" + (dir / "err.txt").string()), 2) << bad;
     EXPECT_NE(slurp(dir / "err.txt").find("--region"), std::string::npos)
         << bad << ": " << slurp(dir / "err.txt");
   }
   // After --res the window is checked against the new size.
-  EXPECT_EQ(run(s + " --res 8x8 --region 0,0,10,8 2>/dev/null"), 2);
+  EXPECT_EQ(run_cli_status(s + " --res 8x8 --region 0,0,10,8 2>/dev/null"), 2);
   EXPECT_FALSE(fs::exists(dir / "x.exr"));
 }
 
@@ -118,15 +106,15 @@ TEST(MergeCli, TilesAssembleIntoTheFullRenderBitForBit) {
   const test::ScratchDir dir("merge_tiles");
   write_scene(dir / "s.json", 2);
   const std::string s = "render " + (dir / "s.json").string() + " --quiet ";
-  ASSERT_EQ(run(s + "-o " + (dir / "full.exr").string()), 0);
+  ASSERT_EQ(run_cli_status(s + "-o " + (dir / "full.exr").string()), 0);
   const char* tiles[] = {"0,0,5,4", "5,0,14,4", "0,4,9,10", "9,4,14,10"};
   std::string inputs;
   for (int i = 0; i < 4; ++i) {
     const std::string t = (dir / ("t" + std::to_string(i) + ".exr")).string();
-    ASSERT_EQ(run(s + "--region " + tiles[i] + " -o " + t), 0);
+    ASSERT_EQ(run_cli_status(s + "--region " + tiles[i] + " -o " + t), 0);
     inputs += t + " ";
   }
-  ASSERT_EQ(run("merge --quiet " + inputs + "-o " + (dir / "m.exr").string()), 0);
+  ASSERT_EQ(run_cli_status("merge --quiet " + inputs + "-o " + (dir / "m.exr").string()), 0);
   ImageMetadata mm, fm;
   const Image m = read_exr(dir / "m.exr", &mm), full = read_exr(dir / "full.exr", &fm);
   EXPECT_EQ(m.display_width, 0);  // the whole frame
@@ -134,13 +122,13 @@ TEST(MergeCli, TilesAssembleIntoTheFullRenderBitForBit) {
   EXPECT_EQ(meta_value(mm, "nimbus/scene"), meta_value(fm, "nimbus/scene"));
   EXPECT_EQ(meta_value(mm, "nimbus/spp"), "2");
   // Two tiles make a crop of their bounding box; a missing one leaves a gap: exit 2, nothing written.
-  ASSERT_EQ(run("merge --quiet " + (dir / "t0.exr").string() + " " + (dir / "t1.exr").string() + " -o " +
-                (dir / "top.exr").string()),
+  ASSERT_EQ(run_cli_status("merge --quiet " + (dir / "t0.exr").string() + " " + (dir / "t1.exr").string() +
+                           " -o " + (dir / "top.exr").string()),
             0);
   EXPECT_EQ(read_exr(dir / "top.exr").height, 4);
   expect_crop_of(dir / "top.exr", dir / "full.exr");
-  EXPECT_EQ(run("merge " + (dir / "t0.exr").string() + " " + (dir / "t3.exr").string() + " -o " +
-                (dir / "gap.exr").string() + " 2>" + (dir / "err.txt").string()),
+  EXPECT_EQ(run_cli_status("merge " + (dir / "t0.exr").string() + " " + (dir / "t3.exr").string() + " -o " +
+                           (dir / "gap.exr").string() + " 2>" + (dir / "err.txt").string()),
             2);
   EXPECT_NE(slurp(dir / "err.txt").find("in no input"), std::string::npos) << slurp(dir / "err.txt");
   EXPECT_FALSE(fs::exists(dir / "gap.exr"));
@@ -150,22 +138,23 @@ TEST(MergeCli, SampleRangesAddUpToTheRenderOfAllSamples) {
   const test::ScratchDir dir("merge_samples");
   write_scene(dir / "s.json", 5);
   const std::string s = "render " + (dir / "s.json").string() + " --quiet ";
-  ASSERT_EQ(run(s + "-o " + (dir / "full.exr").string()), 0);
-  ASSERT_EQ(run(s + "--samples 0:5 -o " + (dir / "all.exr").string()), 0);  // START 0: the plain render
+  ASSERT_EQ(run_cli_status(s + "-o " + (dir / "full.exr").string()), 0);
+  ASSERT_EQ(run_cli_status(s + "--samples 0:5 -o " + (dir / "all.exr").string()),
+            0);  // START 0: the plain render
   expect_crop_of(dir / "all.exr", dir / "full.exr");
-  ASSERT_EQ(run(s + "--samples 0:2 -o " + (dir / "a.exr").string()), 0);
-  ASSERT_EQ(run(s + "--samples 2:3 -o " + (dir / "b.exr").string()), 0);
+  ASSERT_EQ(run_cli_status(s + "--samples 0:2 -o " + (dir / "a.exr").string()), 0);
+  ASSERT_EQ(run_cli_status(s + "--samples 2:3 -o " + (dir / "b.exr").string()), 0);
   // A range resumed to more samples keeps its start: the same as the range rendered in one go.
-  ASSERT_EQ(run(s + "--samples 2:1 -o " + (dir / "b1.exr").string()), 0);
-  ASSERT_EQ(run("render --quiet --resume " + (dir / "b1.exr").string() + " --spp 3"), 0);
+  ASSERT_EQ(run_cli_status(s + "--samples 2:1 -o " + (dir / "b1.exr").string()), 0);
+  ASSERT_EQ(run_cli_status("render --quiet --resume " + (dir / "b1.exr").string() + " --spp 3"), 0);
   expect_crop_of(dir / "b1.exr", dir / "b.exr");
   ImageMetadata bm;
   read_exr(dir / "b.exr", &bm);
   EXPECT_EQ(meta_value(bm, "nimbus/sample_start"), "2");
   EXPECT_EQ(meta_value(bm, "nimbus/spp"), "3");
   // Given in any order; a tile of the second range beside the whole-frame first range works as well.
-  ASSERT_EQ(run("merge --quiet " + (dir / "b.exr").string() + " " + (dir / "a.exr").string() + " -o " +
-                (dir / "m.exr").string()),
+  ASSERT_EQ(run_cli_status("merge --quiet " + (dir / "b.exr").string() + " " + (dir / "a.exr").string() +
+                           " -o " + (dir / "m.exr").string()),
             0);
   ImageMetadata mm, fm;
   const Image m = read_exr(dir / "m.exr", &mm), full = read_exr(dir / "full.exr", &fm);
@@ -196,7 +185,7 @@ TEST(MergeCli, IncompatibleInputsAreRefusedNamingFileAndField) {
   const test::ScratchDir dir("merge_bad");
   write_scene(dir / "s.json", 2);
   const std::string s = "render " + (dir / "s.json").string() + " --quiet ";
-  ASSERT_EQ(run(s + "--samples 0:2 -o " + (dir / "a.exr").string()), 0);
+  ASSERT_EQ(run_cli_status(s + "--samples 0:2 -o " + (dir / "a.exr").string()), 0);
   struct Case {
     std::string render, field;
   } cases[] = {{"--samples 2:2 --seed 9", "nimbus/seed"},
@@ -209,9 +198,9 @@ TEST(MergeCli, IncompatibleInputsAreRefusedNamingFileAndField) {
   int i = 0;
   for (const Case& c : cases) {
     const std::string b = (dir / ("b" + std::to_string(i++) + ".exr")).string();
-    ASSERT_EQ(run(s + c.render + " -o " + b), 0) << c.render;
-    EXPECT_EQ(run("merge " + (dir / "a.exr").string() + " " + b + " -o " + (dir / "m.exr").string() + " 2>" +
-                  (dir / "err.txt").string()),
+    ASSERT_EQ(run_cli_status(s + c.render + " -o " + b), 0) << c.render;
+    EXPECT_EQ(run_cli_status("merge " + (dir / "a.exr").string() + " " + b + " -o " +
+                             (dir / "m.exr").string() + " 2>" + (dir / "err.txt").string()),
               2)
         << c.render;
     const std::string err = slurp(dir / "err.txt");
@@ -226,15 +215,16 @@ TEST(MergeCli, NonRendersAndBadSampleRangesAreRefused) {
   const test::ScratchDir dir("merge_bad_ranges");
   write_scene(dir / "s.json", 2);
   const std::string s = "render " + (dir / "s.json").string() + " --quiet ";
-  ASSERT_EQ(run(s + "--samples 0:2 -o " + (dir / "a.exr").string()), 0);
+  ASSERT_EQ(run_cli_status(s + "--samples 0:2 -o " + (dir / "a.exr").string()), 0);
   // Not a nimbus render, --samples beside --spp, a bad range: exit 2.
   write_exr(dir / "plain.exr", read_exr(dir / "a.exr"));
-  EXPECT_EQ(run("merge " + (dir / "a.exr").string() + " " + (dir / "plain.exr").string() + " -o " +
-                (dir / "m.exr").string() + " 2>/dev/null"),
+  EXPECT_EQ(run_cli_status("merge " + (dir / "a.exr").string() + " " + (dir / "plain.exr").string() + " -o " +
+                           (dir / "m.exr").string() + " 2>/dev/null"),
             2);
-  EXPECT_EQ(run(s + "--samples 0:2 --spp 2 -o " + (dir / "m.exr").string() + " 2>/dev/null"), 2);
+  EXPECT_EQ(run_cli_status(s + "--samples 0:2 --spp 2 -o " + (dir / "m.exr").string() + " 2>/dev/null"), 2);
   for (const char* bad : {"2", "0:0", "-1:2", "1:x", "0:2:3"})
-    EXPECT_EQ(run(s + "--samples " + std::string(bad) + " -o " + (dir / "m.exr").string() + " 2>/dev/null"),
+    EXPECT_EQ(run_cli_status(s + "--samples " + std::string(bad) + " -o " + (dir / "m.exr").string() +
+                             " 2>/dev/null"),
               2)
         << bad;
   EXPECT_FALSE(fs::exists(dir / "m.exr"));

@@ -1,0 +1,56 @@
+// Running the nimbus program from tests (NIMBUS_CLI, set by CMake) and reading what it wrote.
+#pragma once
+
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "nimbus/image.h"
+
+namespace nimbus::test {
+
+struct CliRun {
+  int rc = -1;
+  std::string out;  // stdout and stderr together
+};
+
+// `nimbus ARGS` with its output captured.
+inline CliRun run_cli(const std::string& args) {
+  CliRun r;
+  const std::string cmd = std::string(NIMBUS_CLI) + " " + args + " 2>&1";
+  FILE* p = ::popen(cmd.c_str(), "r");
+  if (!p) return r;
+  char buf[4096];
+  size_t n;
+  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) r.out.append(buf, n);
+  const int status = ::pclose(p);
+  r.rc = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+// `nimbus ARGS` with its output left in the test log; the exit code.
+inline int run_cli_status(const std::string& args) {
+  const int status = std::system((std::string(NIMBUS_CLI) + " " + args).c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+inline std::string slurp(const std::filesystem::path& p) {
+  std::ifstream in(p);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// An EXR header attribute, "(missing)" when absent.
+inline std::string meta_value(const ImageMetadata& meta, const std::string& key) {
+  for (const auto& [k, v] : meta)
+    if (k == key) return v;
+  return "(missing)";
+}
+
+}  // namespace nimbus::test
