@@ -132,8 +132,8 @@ TEST(Adaptive, ReachesItsTargetAndSpendsSamplesOnTheMedium) {
   EXPECT_EQ(n[0], 8.0f);
   EXPECT_GT(n[size_t(10) * 24 + 12], 8.0f);
   EXPECT_LT(r.spp_mean, double(r.spp));
-  // The estimate against the truth: a uniform render of many samples as the reference, its own noise
-  // (estimated the same way) removed. Loose bounds: the estimate is itself a noisy statistic.
+  // The estimate against the truth: an adaptive render to 1 % (another seed) as the reference, its own
+  // noise (its estimate) removed. Loose bounds: the estimate is itself a noisy statistic.
   RenderOptions ref_o;
   ref_o.noise = 0.01;
   ref_o.threads = 2;
