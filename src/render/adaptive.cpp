@@ -3,11 +3,11 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/math.h"
+
 namespace nimbus {
 
 namespace {
-
-double luminance(const double* rgb) { return 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2]; }
 
 // Per pixel: the mean luminance, the unbiased variance of one sample's luminance (0 below 2 samples) and
 // the mean cost of a sample.
@@ -26,7 +26,8 @@ PixelStats pixel_stats(const Film& film, int layer) {
       if (n < 1) continue;
       const size_t i = size_t(y) * W + x;
       const double* a = film.sums(layer, x, y);
-      const double sum = luminance(film.sums(0, x, y)), sum2 = a[0];
+      const double* rgb = film.sums(0, x, y);
+      const double sum = luminance(Rgb(rgb[0], rgb[1], rgb[2])), sum2 = a[0];
       p.mean[i] = sum / n;
       p.cost[i] += a[1] / n;
       if (n >= 2) p.var[i] = std::max(0.0, (sum2 - sum * sum / n) / (n - 1));

@@ -124,13 +124,13 @@ int64_t render_pixel(const Integrator& integrator, const PinholeCamera& camera,
     const uint64_t rng_start = rng.state();
     const Rgb L = integrator.Li(camera.generate_ray(x + jx, y + jy), rng, &sample);
     const double* rgb = to.film.sums(0, x - to.x0, y - to.y0);
-    const double before = to.adaptive_layer >= 0 ? 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2] : 0.0;
+    const double before = to.adaptive_layer >= 0 ? luminance(Rgb(rgb[0], rgb[1], rgb[2])) : 0.0;
     if (!to.layers.add(to.film, x - to.x0, y - to.y0, L, sample)) {
       ++bad;
       continue;  // a dropped sample adds nothing to the deep pixel either
     }
     if (to.adaptive_layer >= 0) {  // the luminance the film took (less a transparent film's background)
-      const double lum = 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2] - before;
+      const double lum = luminance(Rgb(rgb[0], rgb[1], rgb[2])) - before;
       const double a[kAdaptiveChannels] = {lum * lum, double(rng.draws_since(rng_start))};
       to.film.add(to.adaptive_layer, x - to.x0, y - to.y0, a);
     }
