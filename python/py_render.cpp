@@ -138,8 +138,7 @@ py::dict render_py(const py::object& scene_obj, std::optional<int> spp, int thre
   options.time_limit = time_limit.value_or(0.0);
   options.noise = noise.value_or(0.0);
   options.noise_bin = noise_bin;
-  // As render --noise: without an spp, pixels may take up to 4096 samples.
-  if (options.noise > 0.0 && !spp) options.spp = 4096;
+  if (options.noise > 0.0 && !spp) options.spp = kAdaptiveDefaultMaxSpp;  // as render --noise
   options.cancel = &run.cancel;
   // Called from worker threads, possibly out of order: keep the largest count.
   options.progress = [&run](int64_t done, int64_t total, int64_t) {

@@ -29,9 +29,6 @@ extern "C" void on_signal(int sig) {
   g_cancel.store(true);
 }
 
-// render --noise without --spp: the most samples a pixel may take.
-constexpr int kAdaptiveDefaultMaxSpp = 4096;
-
 struct RenderArgs {
   std::string scene;
   std::string output;

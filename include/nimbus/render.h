@@ -63,6 +63,10 @@ struct RenderOptions {
 // (1, 2, 4, ...), the last one to `spp`. A deep image is made in one pass.
 int next_pass_spp(int done, int spp);
 
+// Adaptive sampling (RenderOptions::noise) without an spp from the caller (render --noise, Python's
+// render(noise=...)): the most samples a pixel may take.
+inline constexpr int kAdaptiveDefaultMaxSpp = 4096;
+
 // At most this many deep samples per pixel.
 inline constexpr int kMaxDeepSamples = 1024;
 
