@@ -55,6 +55,7 @@ struct BeamPhotons {
   size_t per_light;
   Vec3 centre;  // of the node grid's bounding sphere, which the photons are aimed at
   double radius;
+  double majorant_scale;  // the share of the majorant that bounds the peak-scatter rate
 
   void trace(size_t j, Rng& rng, PhotonBatch& batch) const;
   Rgb deposit(std::vector<float>& tally, const Vec3& x, const Vec3& w, double t_end, Rgb weight, int c,
@@ -113,7 +114,7 @@ void BeamPhotons::trace(size_t j, Rng& rng, PhotonBatch& batch) const {
   // continuous loss exp(-int sigma_loss) on the weight (zero variance in a uniform medium).
   const auto peak_share = [&](int i) { return peak_fraction[i]; };
   walk_photon(
-      ctx, ph.x, ph.w, rng, &batch.collisions,
+      ctx, ph.x, ph.w, majorant_scale, rng, &batch.collisions,
       [&](const Vec3& p) {
         ctx.media.eval(p, &walk.mp);
         return scattering_shares(walk.mp, ctx.media.count(), walk.c, peak_share).sum;
@@ -177,6 +178,7 @@ BeamGrid::BeamGrid(const SceneContext& ctx, const std::vector<const PhaseSplit*>
   // Photons cover the whole node grid (its padding included), so every node's estimate is complete.
   const double radius = 0.5 * (grid_.bounds.hi - grid_.bounds.lo).length() * (1.0 + 1e-9) + 1e-12;
 
+  const double scale = majorant_share(ctx.media, [&](int i) { return peak_fraction[i]; });
   for (size_t l = 0; l < ctx.lights.size(); ++l) {
     const Light& light = ctx.lights[l];
     const auto* dir = std::get_if<DirectionalLight>(&light);
@@ -194,7 +196,8 @@ BeamGrid::BeamGrid(const SceneContext& ctx, const std::vector<const PhaseSplit*>
                            .grey = grey,
                            .per_light = per_light,
                            .centre = centre,
-                           .radius = radius};
+                           .radius = radius,
+                           .majorant_scale = scale};
     // The batches' sums divided by the node volume.
     values_[l] = trace_photons(
         total, seed ^ 0x7065616b6265616dull ^ (uint64_t(l) << 40), grid_.size() * kFloats,

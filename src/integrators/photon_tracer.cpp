@@ -3,6 +3,7 @@
 
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "integrators/env_light.h"
@@ -109,6 +110,18 @@ std::vector<float> trace_photons(size_t total, uint64_t stream_seed, size_t tall
   });
   for (const PhotonBatch& pb : batch) *rejection_failures += pb.rejection_failures;
   return sum;
+}
+
+double majorant_share(const SceneMedia& media, const std::function<double(int)>& kept) {
+  double share = media.count() > 0 ? 0.0 : 1.0;
+  for (int i = 0; i < media.count(); ++i) {
+    const Medium& m = media.medium(i);
+    const double full = max_component(m.sigma_s + m.sigma_a);
+    if (!(full > 0.0)) continue;
+    const double k = std::clamp(kept(i), 0.0, 1.0);
+    share = std::max(share, std::min(1.0, max_component(m.sigma_a + m.sigma_s * k) / full));
+  }
+  return share;
 }
 
 }  // namespace nimbus

@@ -18,26 +18,24 @@ namespace {
 constexpr int kMaxWideScatters = 1024;  // photons are ended after this many wide scatters (or
                                         // kMaxPhotonEvents real collisions)
 
-// Adds value v (per channel; only channels with a non-zero entry) times the harmonics y at q to the
-// tally's nodes around q (per node: channel c at [coeffs c + h], as ScatterGrid::values_).
-void splat(std::vector<float>& tally, const NodeGrid& grid, int coeffs, const Vec3& q, const double* y,
-           const Rgb& v) {
-  const int floats_per_node = 3 * coeffs;
+// Adds the per-node values `add` (count floats, node offset `first`) times the trilinear weights at q
+// to the tally's nodes around q. One flight's values are the same at every sample: they are computed
+// once, in float, and the node loop is a contiguous multiply-add the compiler vectorises.
+void splat(std::vector<float>& tally, const NodeGrid& grid, int floats_per_node, int first, int count,
+           const Vec3& q, const float* add) {
   const TrilinearStencil st = grid.stencil(q);
   for (int k = 0; k < 8; ++k) {
-    const double wt = st.weight[k];
-    if (wt <= 0.0) continue;
-    float* node = &tally[st.node[k] * floats_per_node];
-    for (int c = 0; c < 3; ++c) {
-      if (v[c] == 0.0) continue;
-      const double e = wt * v[c];
-      for (int h = 0; h < coeffs; ++h) node[coeffs * c + h] += float(e * y[h]);
-    }
+    const float wt = float(st.weight[k]);
+    if (wt <= 0.0f) continue;
+    float* node = &tally[st.node[k] * floats_per_node + first];
+    for (int i = 0; i < count; ++i) node[i] += wt * add[i];
   }
 }
 
 // Track-length deposit of the flight x + t w, t in [0, t_end] (clipped to the node grid): samples at
-// most half a spacing apart, each splatting its share of power x length times the harmonics of w.
+// most half a spacing apart, each splatting its share of power x length times the harmonics of w
+// (per node: channel c at [coeffs c + h], as ScatterGrid::values_; only the channels from the first
+// to the last with non-zero power are touched).
 void deposit_flight(std::vector<float>& tally, const NodeGrid& grid, int bands, const Vec3& x, const Vec3& w,
                     double t_end, const Rgb& power) {
   double t0, t1;
@@ -47,9 +45,19 @@ void deposit_flight(std::vector<float>& tally, const NodeGrid& grid, int bands, 
   const int n = std::max(1, int(std::ceil(len / (0.5 * grid.min_spacing()))));
   const Rgb v = power * (len / n);
   NIMBUS_DCHECK(min_component(v) >= 0.0 && std::isfinite(max_component(v)));
+  int c_lo = 0, c_hi = 2;
+  while (c_lo < 3 && v[c_lo] == 0.0) ++c_lo;
+  while (c_hi >= c_lo && v[c_hi] == 0.0) --c_hi;
+  if (c_lo > c_hi) return;
+  const int coeffs = bands * bands;
   double y[kShMaxBands * kShMaxBands];
   sh_eval(w, bands, y);
-  for (int k = 0; k < n; ++k) splat(tally, grid, bands * bands, x + w * (t0 + (k + 0.5) * len / n), y, v);
+  float add[3 * kShMaxBands * kShMaxBands];
+  for (int c = c_lo; c <= c_hi; ++c)
+    for (int h = 0; h < coeffs; ++h) add[coeffs * (c - c_lo) + h] = float(v[c] * y[h]);
+  const int first = coeffs * c_lo, count = coeffs * (c_hi - c_lo + 1);
+  for (int k = 0; k < n; ++k)
+    splat(tally, grid, 3 * coeffs, first, count, x + w * (t0 + (k + 0.5) * len / n), add);
 }
 
 // The next pre-filtered level: the values (`floats` per node) of `fine` at its nodes 2j, filtered with
@@ -106,7 +114,8 @@ struct ScatterPhotons {
   const EmissionSampler* emission;  // null when no medium emits
   Vec3 centre;                      // of the media's bounding sphere, which the photons are aimed at
   double radius;
-  int K;  // flights after wide scatter 1 .. K - 1 are kept
+  int K;                  // flights after wide scatter 1 .. K - 1 are kept
+  double majorant_scale;  // the share of the majorant that bounds the extinction the photons see
 
   void trace(size_t j, Rng& rng, PhotonBatch& batch) const;
   bool reflect(const SurfaceHit& hit, Vec3* w, int c, double* weight, int* order, Rng& rng) const;
@@ -136,7 +145,7 @@ void ScatterPhotons::trace(size_t j, Rng& rng, PhotonBatch& batch) const {
   double weight = 1.0;
   int order = 0;  // wide scatters so far
   walk_photon(
-      ctx, ph.x, ph.w, rng, &batch.collisions,
+      ctx, ph.x, ph.w, majorant_scale, rng, &batch.collisions,
       [&](const Vec3& p) {
         return s.exact_transport ? ctx.media.sigma_t(p)[c] : reduced_sigma_t(ctx.media, p, peak_fraction)[c];
       },
@@ -261,7 +270,9 @@ void ScatterGrid::trace(const SceneContext& ctx, const std::vector<const PhaseSp
       .emission = emission.active() ? &emission : nullptr,
       .centre = (media_bounds.lo + media_bounds.hi) * 0.5,
       .radius = 0.5 * extent.length() * (1.0 + 1e-9) + 1e-12,
-      .K = s.max_wide_scatters <= 0 ? kMaxWideScatters : std::min(s.max_wide_scatters, kMaxWideScatters)};
+      .K = s.max_wide_scatters <= 0 ? kMaxWideScatters : std::min(s.max_wide_scatters, kMaxWideScatters),
+      .majorant_scale =
+          s.exact_transport ? 1.0 : majorant_share(ctx.media, [&](int i) { return 1.0 - peak_fraction[i]; })};
   // The batches' sums divided by the node volume: fluence and flux.
   values_ = trace_photons(
       total, s.seed ^ 0x6d756c7469706c65ull, values_.size(), 1.0 / grid_.cell_volume(),

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "core/check.h"
 #include "core/rng.h"
@@ -18,10 +19,14 @@ namespace nimbus {
 // Calls on_collision(p, majorant) -> bool at tentative collisions along o + t d (d unit), t in
 // (0, tmax). Returns true when the ray reached tmax (or left the media), false when the callback
 // stopped it.
+// scale (in [0, 1]) multiplies every cell's majorant: for a density known to stay below that share
+// of the extinction (mfs's photons see a reduced extinction), fewer tentative collisions.
 template <typename F>
-bool track(const MajorantGrid& grid, const Vec3& o, const Vec3& d, double tmax, Rng& rng, F&& on_collision) {
+bool track(const MajorantGrid& grid, const Vec3& o, const Vec3& d, double tmax, double scale, Rng& rng,
+           F&& on_collision) {
   bool reached_end = true;
-  grid.traverse(o, d, 0.0, tmax, [&](double t0, double t1, double maj) {
+  grid.traverse(o, d, 0.0, tmax, [&](double t0, double t1, double cell_maj) {
+    const double maj = cell_maj * scale;
     NIMBUS_DCHECK(maj >= 0.0 && std::isfinite(maj));
     if (maj <= 0.0) return true;
     double t = t0;
@@ -36,6 +41,11 @@ bool track(const MajorantGrid& grid, const Vec3& o, const Vec3& d, double tmax, 
     }
   });
   return reached_end;
+}
+
+template <typename F>
+bool track(const MajorantGrid& grid, const Vec3& o, const Vec3& d, double tmax, Rng& rng, F&& on_collision) {
+  return track(grid, o, d, tmax, 1.0, rng, std::forward<F>(on_collision));
 }
 
 // The fixed-optical-depth march of the deterministic integrators: each majorant cell's segment of
