@@ -102,7 +102,7 @@ TEST(Lidar, McAtSmallOpticalDepthIsTheSingleScatterEquation) {
   const std::vector<double> ss = lidar_single_scatter(s);
   for (size_t i = 0; i < ss.size(); ++i) {
     const Estimate& e = mc.received.bins[i];
-    EXPECT_LT(e.err, 0.02 * ss[i]) << i;  // the test has power
+    EXPECT_LT(e.err, 0.03 * ss[i]) << i;  // the test has power
     EXPECT_NEAR(e.value, ss[i], 5.0 * e.err) << i;
   }
   EXPECT_EQ(mc.received.before.value, 0.0);  // nothing from the clear gap
@@ -157,27 +157,30 @@ TEST(Lidar, McTimeIntegralEqualsAnIndependentAnalogTally) {
 }
 
 TEST(Lidar, McMicroscopicBeerLambert) {
-  // With absorption a, each bin holds the absorption-free run's light weighted by exp(-a t) (n = 1).
+  // With absorption a, each bin holds the absorption-free run's light weighted by exp(-a s), s the path
+  // inside the slab: t minus the clear gap out and back (n = 1).
   LidarSettings s = thin_settings();
   s.sigma_s = 1.0;
   s.sigma_a = 0.0;
   s.thickness = 3.0;
-  s.fov = 0.05;
-  s.photons = 100000;
+  s.phase = HgPhase{0.5};  // a mild forward peak: a local estimate of low variance
+  s.fov = 0.1;
+  s.photons = 200000;
   s.time_edges.clear();
-  for (int i = 0; i <= 25; ++i) s.time_edges.push_back(1.0 + 0.2 * i);
+  for (int i = 0; i <= 16; ++i) s.time_edges.push_back(1.0 + 0.25 * i);
   const LidarMcResult clear = run_lidar_mc(s);
   s.sigma_a = 0.3;
   s.seed = 8;
   const LidarMcResult absorbing = run_lidar_mc(s);
   int powerful = 0;
   for (size_t i = 0; i + 1 < s.time_edges.size(); ++i) {
-    const double t = 0.5 * (s.time_edges[i] + s.time_edges[i + 1]), w = std::exp(-s.sigma_a * t);
+    const double t = 0.5 * (s.time_edges[i] + s.time_edges[i + 1]),
+                 w = std::exp(-s.sigma_a * (t - 2.0 * s.distance));
     const Estimate &c = clear.received.bins[i], &a = absorbing.received.bins[i];
     EXPECT_NEAR(a.value, w * c.value, 5.0 * std::hypot(a.err, w * c.err) + 2e-3 * a.value) << t;
     powerful += a.err < 0.05 * a.value;
   }
-  EXPECT_GE(powerful, 15);
+  EXPECT_GE(powerful, 10);
 }
 
 TEST(Lidar, McIsTheSameForAnyNumberOfThreads) {
