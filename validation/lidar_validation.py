@@ -31,7 +31,7 @@ CASES = {
     "cloud_hg0.85_a0.99_fov1mrad": ("hg:0.85", 0.99, 50.0, 8.0, 0.001, 0.01, 16),
     "cloud_hg0.85_a0.99_fov10mrad": ("hg:0.85", 0.99, 50.0, 8.0, 0.01, 0.01, 16),
     "cloud_hg0.95_a0.99_fov10mrad": ("hg:0.95", 0.99, 50.0, 8.0, 0.01, 0.01, 16),
-    "gauss0.002_a0.95_fov20mrad": ("gauss:0.002", 0.95, 2.0, 8.0, 0.02, 0.01, 16),
+    "ocean_dhg_a0.95_fov20mrad": ("dhg:0.95,-0.5,0.95", 0.95, 2.0, 8.0, 0.02, 0.01, 16),
     "mie_a0.99_fov10mrad": ("mie:cloud_mie_550nm", 0.99, 50.0, 8.0, 0.01, 0.01, 16),
 }
 
@@ -59,6 +59,8 @@ def report(name, rows):
     out = []
     for m, f, s in zip(mc, mfs, rows["single"]):
         v, e, fv, sv = float(m["value"]), float(m["stderr"]), float(f["value"]), float(s["value"])
+        if not (v > 0 and sv > 0):
+            continue
         z = 0.5 * (float(m["tlo"]) + float(m["thi"])) / 2 - dist
         print(f"| {z:.2f} | {v:.4g} | {e / v * 100:.1f} % | {fv:.4g} | {sv:.4g} | {fv / v - 1:+.3f} | "
               f"{sv / v - 1:+.3f} | {v / sv:.3f} |")
