@@ -35,7 +35,7 @@ std::vector<std::string> split(const std::string& line) {
 
 const std::string kArgs =
     "lidar --mu-s 1 --albedo 0.9 --phase hg:0.9 --thickness 2 --distance 1 --fov 0.05 --receiver-radius 0.1 "
-    "--photons 20000 --time-edges 2.5:6:7";
+    "--photons 20000 --time-edges 2:6:8";
 
 TEST(CliLidar, WritesTheCsvItPromises) {
   const auto out = temp_dir() / "lidar.csv";
@@ -53,41 +53,55 @@ TEST(CliLidar, WritesTheCsvItPromises) {
     EXPECT_EQ(v[6], "1/length^2 per photon");
     rows[v[0]].push_back(v);
   }
-  ASSERT_EQ(rows["mc"].size(), 9u);  // 0..2.5, seven bins, 6..inf
-  ASSERT_EQ(rows["mfs"].size(), 9u);
-  ASSERT_EQ(rows["single"].size(), 7u);
+  ASSERT_EQ(rows["mc"].size(), 10u);  // 0..2, eight bins, 6..inf
+  ASSERT_EQ(rows["mfs"].size(), 10u);
+  ASSERT_EQ(rows["single"].size(), 8u);
   ASSERT_EQ(rows["mc_analog"].size(), 1u);
   EXPECT_EQ(std::stod(rows["mc"].front()[3]), 0.0);  // the clear gap: nothing before 2 d
   EXPECT_TRUE(std::isinf(std::stod(rows["mc"].back()[2])));
   // Every model's bins hold at least the single-scatter return (mfs) or about it (mc, within noise).
-  for (int i = 0; i < 7; ++i) {
+  for (int i = 0; i < 8; ++i) {
     const double ss = std::stod(rows["single"][i][3]);
     EXPECT_GE(std::stod(rows["mfs"][i + 1][3]), ss * (1.0 - 1e-9));
     EXPECT_GT(std::stod(rows["mc"][i + 1][3]) + 5.0 * std::stod(rows["mc"][i + 1][4]), ss);
   }
 }
 
-TEST(CliLidar, BadInputExitsTwoNamingTheArgumentAndWritesNothing) {
+// Each case exits 2, names `named` and writes nothing.
+void expect_refused(const std::vector<std::pair<std::string, std::string>>& cases) {
   const auto out = temp_dir() / "bad.csv";
   const std::string base =
       "lidar --mu-s 1 --albedo 0.9 --g 0.9 --thickness 2 --photons 100 -o " + out.string() + " ";
-  const std::vector<std::pair<std::string, std::string>> cases = {
-      {"--fov 0.01 --time-edges ''", "--time-edges"},
-      {"--fov 0.01 --time-edges 3,2", "--time-edges"},
-      {"--fov 0.01 --time-edges -1,2", "--time-edges"},
-      {"--fov 0 --time-edges 1,2", "--fov"},
-      {"--fov 2 --time-edges 1,2", "--fov"},
-      {"--fov 0.01 --receiver-radius -1 --time-edges 1,2", "--receiver-radius"},
-      {"--fov 0.01 --distance -1 --time-edges 1,2", "--distance"},
-      {"--fov 0.01 --mu-a 0.1 --time-edges 1,2", "--albedo"},
-      {"--fov 0.01 --models mc,foo --time-edges 1,2", "--models"},
-  };
   for (const auto& [args, named] : cases) {
     const CliRun r = run_cli(base + args);
     EXPECT_EQ(r.rc, 2) << args << "\n" << r.out;
     EXPECT_NE(r.out.find(named), std::string::npos) << args << "\n" << r.out;
     EXPECT_FALSE(std::filesystem::exists(out)) << args;
   }
+}
+
+TEST(CliLidar, BadTimeEdgesExitTwoNamingTheArgument) {
+  expect_refused({
+      {"--fov 0.01 --time-edges ''", "--time-edges"},
+      {"--fov 0.01 --time-edges 3,2", "--time-edges"},
+      {"--fov 0.01 --time-edges -1,2", "--time-edges"},
+  });
+}
+
+TEST(CliLidar, BadGeometryExitsTwoNamingTheArgument) {
+  expect_refused({
+      {"--fov 0 --time-edges 1,2", "--fov"},
+      {"--fov 2 --time-edges 1,2", "--fov"},
+      {"--fov 0.01 --receiver-radius -1 --time-edges 1,2", "--receiver-radius"},
+      {"--fov 0.01 --distance -1 --time-edges 1,2", "--distance"},
+  });
+}
+
+TEST(CliLidar, BadMediumOrModelsExitTwoAndTheOutputIsCheckedFirst) {
+  expect_refused({
+      {"--fov 0.01 --mu-a 0.1 --time-edges 1,2", "--albedo"},
+      {"--fov 0.01 --models mc,foo --time-edges 1,2", "--models"},
+  });
   // The output path is checked before any work (a billion photons would take hours).
   const CliRun r = run_cli(
       "lidar --mu-s 1 --albedo 0.9 --g 0.9 --thickness 2 --fov 0.01 --time-edges 1,2 --photons 1e9 -o "
