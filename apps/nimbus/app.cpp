@@ -17,6 +17,7 @@ void build_app(CLI::App& app, Action& action) {
   add_beam_command(app, action);
   add_slab_command(app, action);
   add_merge_command(app, action);
+  add_lidar_command(app, action);
 }
 
 }  // namespace nimbus::cli

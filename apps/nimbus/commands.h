@@ -21,6 +21,7 @@ void add_convert_command(CLI::App& app, Action& action);
 void add_beam_command(CLI::App& app, Action& action);
 void add_slab_command(CLI::App& app, Action& action);
 void add_merge_command(CLI::App& app, Action& action);
+void add_lidar_command(CLI::App& app, Action& action);
 
 // Throws nimbus::Error (naming `option`) unless `path` names a file in an existing folder: checked before
 // the work, so that a long run never ends in a path it cannot write.

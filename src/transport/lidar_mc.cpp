@@ -1,0 +1,179 @@
+// Photon Monte Carlo of a lidar return (lidar.h): next-event estimation toward the receiver at every
+// scattering event, binned by total path length, with batch-mean standard errors.
+#include <fmt/format.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/rng.h"
+#include "nimbus/error.h"
+#include "transport/lidar.h"
+#include "transport/time_resolved.h"
+
+namespace nimbus {
+
+void validate_lidar(const LidarSettings& s, bool monte_carlo) {
+  auto bad = [](const std::string& m) { throw Error("lidar: " + m); };
+  if (!(s.sigma_s >= 0.0) || !std::isfinite(s.sigma_s)) bad("sigma_s must be finite and >= 0");
+  if (!(s.sigma_a >= 0.0) || !std::isfinite(s.sigma_a)) bad("sigma_a must be finite and >= 0");
+  if (!std::isfinite(s.sigma_s + s.sigma_a)) bad("sigma_s + sigma_a must be finite");
+  if (!(s.thickness > 0.0) || !std::isfinite(s.thickness)) bad("thickness must be finite and > 0");
+  if (!(s.distance >= 0.0) || !std::isfinite(s.distance)) bad("distance must be finite and >= 0");
+  if (!(s.n >= 1.0) || !(s.n <= 10.0)) bad("n must lie in [1, 10]");
+  if (!(s.r_rx >= 0.0) || !std::isfinite(s.r_rx)) bad("receiver radius must be finite and >= 0");
+  if (!(s.fov > 0.0) || !(s.fov < 0.5 * kPi)) bad("fov (half-angle) must lie in (0, pi/2)");
+  if (s.time_edges.size() < 2) bad("time edges need at least two values");
+  if (s.time_edges.size() - 1 > kMaxTimeBins) bad(fmt::format("at most {} time bins", kMaxTimeBins));
+  for (size_t i = 0; i < s.time_edges.size(); ++i) {
+    if (!(s.time_edges[i] >= 0.0) || !std::isfinite(s.time_edges[i]))
+      bad("time edges must be finite and >= 0");
+    if (i > 0 && !(s.time_edges[i] > s.time_edges[i - 1])) bad("time edges must increase");
+  }
+  if (!monte_carlo) return;
+  if (s.batches < 2) bad("needs at least 2 batches");
+  if (s.photons < uint64_t(s.batches)) bad("needs at least one photon per batch");
+}
+
+namespace {
+
+constexpr double kRouletteThreshold = 1e-4;  // MCML
+constexpr double kRouletteSurvival = 0.1;
+
+// Accumulator slots: [0, TS) time slots (before, bins, after), then the analog tally.
+struct LidarLayout {
+  size_t TS;
+  size_t analog() const { return TS; }
+  size_t size() const { return TS + 1; }
+};
+
+size_t slot_of(const std::vector<double>& edges, double t) {
+  if (t < edges.front()) return 0;
+  if (t >= edges.back()) return edges.size();
+  return size_t(std::upper_bound(edges.begin(), edges.end(), t) - edges.begin());
+}
+
+// One photon history.
+class LidarTracer {
+ public:
+  LidarTracer(const LidarSettings& s, const LidarLayout& L)
+      : s_(s), L_(L), sigma_t_(s.sigma_s + s.sigma_a), cos_fov_(std::cos(s.fov)) {}
+
+  void trace(Rng& rng, double* acc) const {
+    if (!(sigma_t_ > 0.0)) return;  // nothing scatters: nothing returns
+    const double albedo = s_.sigma_s / sigma_t_;
+    const double z0 = s_.distance, z1 = s_.distance + s_.thickness;
+    Vec3 p(0.0, 0.0, z0), d(0.0, 0.0, 1.0);  // across the clear gap to the near face
+    double w = 1.0, path = z0;
+    while (true) {
+      // Free flight; a photon reaching a face leaves (matched boundaries).
+      const double step = -std::log(1.0 - rng.uniform()) / sigma_t_;
+      const double s_face = d.z > 0.0 ? (z1 - p.z) / d.z : d.z < 0.0 ? (z0 - p.z) / d.z : 1e300;
+      if (step >= s_face) {
+        if (d.z < 0.0) tally_analog(p + d * s_face, d, w, acc);
+        return;
+      }
+      p += d * step;
+      path += step;
+      // Scattering event: next-event estimate toward the receiver, then the scatter itself.
+      w *= albedo;
+      next_event(rng, p, d, path, w, acc);
+      const double u1 = rng.uniform(), u2 = rng.uniform();
+      d = normalize(phase_sample(s_.phase, d, u1, u2));
+      if (w < kRouletteThreshold) {
+        if (rng.uniform() >= kRouletteSurvival) return;
+        w /= kRouletteSurvival;
+      }
+    }
+  }
+
+ private:
+  // Local estimate: scatter toward a point y of the receiver (uniform on the disk), no collision on the
+  // way back (exp(-sigma_t L_in), L_in the part inside the slab), received irradiance cos / L^2 if the
+  // arriving direction lies within the FOV.  Always draws two numbers (the same stream for any FOV).
+  void next_event(Rng& rng, const Vec3& p, const Vec3& d, double path, double w, double* acc) const {
+    const double u1 = rng.uniform(), u2 = rng.uniform();
+    const double rr = s_.r_rx * std::sqrt(u1), phi = 2.0 * kPi * u2;
+    const Vec3 delta = Vec3(rr * std::cos(phi), rr * std::sin(phi), 0.0) - p;
+    const double L = length(delta);
+    if (!(L > 0.0) || !(p.z > 0.0)) return;
+    const Vec3 u = delta / L;
+    const double cos_r = -u.z;  // angle between the arriving direction and the receiver's axis (-z)
+    if (cos_r < cos_fov_) return;
+    const double inside = L * (p.z - s_.distance) / p.z;  // the part of the return leg in the slab
+    const double e = w * phase_eval(s_.phase, dot(d, u)) * std::exp(-sigma_t_ * inside) * cos_r / (L * L);
+    acc[slot_of(s_.time_edges, s_.n * (path + L))] += e;
+  }
+
+  // The analog tally: a photon leaving through the near face that crosses the gap into the disk within
+  // the FOV.
+  void tally_analog(const Vec3& exit, const Vec3& d, double w, double* acc) const {
+    const Vec3 at = exit + d * (exit.z / -d.z);  // where it meets the plane of the receiver
+    if (s_.r_rx > 0.0 && std::hypot(at.x, at.y) < s_.r_rx && -d.z >= cos_fov_)
+      acc[L_.analog()] += w / (kPi * s_.r_rx * s_.r_rx);
+  }
+
+  const LidarSettings& s_;
+  const LidarLayout& L_;
+  double sigma_t_, cos_fov_;
+};
+
+struct LidarBatches {
+  std::vector<std::vector<double>> sums;
+  std::vector<uint64_t> counts;
+};
+
+// Mean over all photons of f(batch sums), standard error from the spread of batch means.
+template <class F>
+Estimate batch_mean(const LidarBatches& b, uint64_t photons, F f) {
+  const int B = int(b.sums.size());
+  const double N = double(photons);
+  double total = 0.0;
+  for (int i = 0; i < B; ++i) total += f(b.sums[i]);
+  const double mean = total / N;
+  double var = 0.0;
+  for (int i = 0; i < B; ++i) {
+    const double fb = double(b.counts[i]) / N, xb = f(b.sums[i]) / double(b.counts[i]);
+    var += fb * fb * (xb - mean) * (xb - mean);
+  }
+  return Estimate{mean, std::sqrt(var * double(B) / double(B - 1))};
+}
+
+}  // namespace
+
+LidarMcResult run_lidar_mc(const LidarSettings& s) {
+  validate_lidar(s, true);
+  const LidarLayout L{s.time_edges.size() + 1};
+  const int B = s.batches;
+  LidarBatches b;
+  b.sums.assign(B, std::vector<double>(L.size(), 0.0));
+  std::vector<uint64_t> first(B);
+  b.counts.resize(B);
+  for (int i = 0; i < B; ++i) {
+    b.counts[i] = s.photons / B + (uint64_t(i) < s.photons % B ? 1 : 0);
+    first[i] = i == 0 ? 0 : first[i - 1] + b.counts[i - 1];
+  }
+  const LidarTracer tracer(s, L);
+  tbb::parallel_for(tbb::blocked_range<int>(0, B, 1), [&](const tbb::blocked_range<int>& range) {
+    for (int i = range.begin(); i < range.end(); ++i)
+      for (uint64_t k = first[i]; k < first[i] + b.counts[i]; ++k) {
+        Rng rng(s.seed, k);
+        tracer.trace(rng, b.sums[i].data());
+      }
+  });
+  LidarMcResult r;
+  auto slot = [&](size_t j) { return batch_mean(b, s.photons, [j](const auto& v) { return v[j]; }); };
+  r.received.before = slot(0);
+  for (size_t j = 1; j + 1 < L.TS; ++j) r.received.bins.push_back(slot(j));
+  r.received.after = slot(L.TS - 1);
+  r.total = batch_mean(b, s.photons, [&](const auto& v) {
+    double t = 0.0;
+    for (size_t j = 0; j < L.TS; ++j) t += v[j];
+    return t;
+  });
+  r.analog = slot(L.analog());
+  return r;
+}
+
+}  // namespace nimbus

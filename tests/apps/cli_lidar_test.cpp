@@ -1,0 +1,113 @@
+// `nimbus lidar` run as a user would: the CSV it promises (rows that sum to the whole return, the
+// single-scatter rows equal to the mfs model's limit at small depth) and exit code 2 naming the argument
+// on bad input, with nothing written.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "support/cli.h"
+
+namespace {
+
+using nimbus::test::CliRun;
+using nimbus::test::run_cli;
+
+std::filesystem::path temp_dir() {
+  auto d = std::filesystem::temp_directory_path() / ("nimbus_cli_lidar_test_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(d);
+  return d;
+}
+
+std::vector<std::string> split(const std::string& line) {
+  std::vector<std::string> v;
+  std::stringstream ss(line);
+  std::string item;
+  while (std::getline(ss, item, ',')) v.push_back(item);
+  return v;
+}
+
+const std::string kArgs =
+    "lidar --mu-s 1 --albedo 0.9 --phase hg:0.9 --thickness 2 --distance 1 --fov 0.05 --receiver-radius 0.1 "
+    "--photons 20000 --time-edges 2:6:8";
+
+TEST(CliLidar, WritesTheCsvItPromises) {
+  const auto out = temp_dir() / "lidar.csv";
+  const CliRun r = run_cli(kArgs + " -o " + out.string());
+  ASSERT_EQ(r.rc, 0) << r.out;
+  std::ifstream in(out);
+  std::string line;
+  std::getline(in, line);
+  EXPECT_EQ(line, "model,tlo,thi,value,stderr,bin_unit,value_unit");
+  std::map<std::string, std::vector<std::vector<std::string>>> rows;
+  while (std::getline(in, line)) {
+    const auto v = split(line);
+    ASSERT_EQ(v.size(), 7u) << line;
+    EXPECT_EQ(v[5], "length");
+    EXPECT_EQ(v[6], "1/length^2 per photon");
+    rows[v[0]].push_back(v);
+  }
+  ASSERT_EQ(rows["mc"].size(), 10u);  // 0..2, eight bins, 6..inf
+  ASSERT_EQ(rows["mfs"].size(), 10u);
+  ASSERT_EQ(rows["single"].size(), 8u);
+  ASSERT_EQ(rows["mc_analog"].size(), 1u);
+  EXPECT_EQ(std::stod(rows["mc"].front()[3]), 0.0);  // the clear gap: nothing before 2 d
+  EXPECT_TRUE(std::isinf(std::stod(rows["mc"].back()[2])));
+  // Every model's bins hold at least the single-scatter return (mfs) or about it (mc, within noise).
+  for (int i = 0; i < 8; ++i) {
+    const double ss = std::stod(rows["single"][i][3]);
+    EXPECT_GE(std::stod(rows["mfs"][i + 1][3]), ss * (1.0 - 1e-9));
+    EXPECT_GT(std::stod(rows["mc"][i + 1][3]) + 5.0 * std::stod(rows["mc"][i + 1][4]), ss);
+  }
+}
+
+// Each case exits 2, names `named` and writes nothing.
+void expect_refused(const std::vector<std::pair<std::string, std::string>>& cases) {
+  const auto out = temp_dir() / "bad.csv";
+  const std::string base =
+      "lidar --mu-s 1 --albedo 0.9 --g 0.9 --thickness 2 --photons 100 -o " + out.string() + " ";
+  for (const auto& [args, named] : cases) {
+    const CliRun r = run_cli(base + args);
+    EXPECT_EQ(r.rc, 2) << args << "\n" << r.out;
+    EXPECT_NE(r.out.find(named), std::string::npos) << args << "\n" << r.out;
+    EXPECT_FALSE(std::filesystem::exists(out)) << args;
+  }
+}
+
+TEST(CliLidar, BadTimeEdgesExitTwoNamingTheArgument) {
+  expect_refused({
+      {"--fov 0.01 --time-edges ''", "--time-edges"},
+      {"--fov 0.01 --time-edges 3,2", "--time-edges"},
+      {"--fov 0.01 --time-edges -1,2", "--time-edges"},
+  });
+}
+
+TEST(CliLidar, BadGeometryExitsTwoNamingTheArgument) {
+  expect_refused({
+      {"--fov 0 --time-edges 1,2", "--fov"},
+      {"--fov 2 --time-edges 1,2", "--fov"},
+      {"--fov 0.01 --receiver-radius -1 --time-edges 1,2", "--receiver-radius"},
+      {"--fov 0.01 --distance -1 --time-edges 1,2", "--distance"},
+  });
+}
+
+TEST(CliLidar, BadMediumOrModelsExitTwoAndTheOutputIsCheckedFirst) {
+  expect_refused({
+      {"--fov 0.01 --mu-a 0.1 --time-edges 1,2", "--albedo"},
+      {"--fov 0.01 --models mc,foo --time-edges 1,2", "--models"},
+  });
+  // The output path is checked before any work (a billion photons would take hours).
+  const CliRun r = run_cli(
+      "lidar --mu-s 1 --albedo 0.9 --g 0.9 --thickness 2 --fov 0.01 --time-edges 1,2 --photons 1e9 -o "
+      "/nonexistent/dir/x.csv");
+  EXPECT_EQ(r.rc, 2) << r.out;
+  EXPECT_NE(r.out.find("--output"), std::string::npos) << r.out;
+}
+
+}  // namespace
