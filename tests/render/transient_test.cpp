@@ -88,6 +88,29 @@ TEST(Transient, BinsSumToTheSteadyImageWhichIsUnchangedForAnyThreadCount) {
   EXPECT_GE(used, 5);
 }
 
+// A transparent film leaves the environment seen directly out of the bins as out of the image; a region's
+// bins are the full render's bins of its pixels.
+TEST(Transient, TransparentFilmsAndRegionsKeepTheBinsSummingToTheImage) {
+  const Scene scene =
+      test::scene_from_json(mixed_scene(R"(, "film": {"transparent": true, "time_bins": [2, 12, 10]})"));
+  RenderOptions full_opt, region_opt;
+  full_opt.threads = region_opt.threads = 2;
+  region_opt.region = Region{3, 2, 9, 7};
+  const RenderResult full = render(scene, full_opt), crop = render(scene, region_opt);
+  ASSERT_EQ(crop.transient.width, 6);
+  for (int y = 0; y < crop.image.height; ++y)
+    for (int x = 0; x < crop.image.width; ++x) {
+      const size_t i = size_t(y) * 6 + size_t(x),
+                   j = size_t(y + 2) * size_t(full.image.width) + size_t(x + 3);
+      double sum = 0.0;
+      for (size_t k = 0; k < crop.transient.channels.size(); ++k) {
+        EXPECT_EQ(crop.transient.channels[k].data[i], full.transient.channels[k].data[j]);
+        if (k % 3 == 2) sum += crop.transient.channels[k].data[i];  // blue: the sky's strongest channel
+      }
+      EXPECT_NEAR(sum, crop.image.rgb[3 * i + 2], 1e-5 * std::abs(crop.image.rgb[3 * i + 2]) + 1e-7);
+    }
+}
+
 // Path lengths of single scattering in a slab |y| < 0.5 seen by a camera at (0, -5, 0) looking along +y,
 // a point light at kLight outside it: s(t) = t + |x(t) - light|, x(t) = (0, -5 + t, 0).
 const Vec3 kLight{0.8, -2.0, 0.3};
