@@ -42,16 +42,17 @@ struct RenderArgs {
   int deep_samples = 32;
   int threads = 0;
   double exposure = 0.0;
-  double time_limit = 0.0;            // --time: seconds, 0 = none
-  std::string resume;                 // --resume: the EXR to continue
-  std::vector<std::string> sets;      // --set PATH=VALUE
-  std::string res;                    // --res WxH
-  std::string region;                 // --region x0,y0,x1,y1
-  std::string samples;                // --samples START:COUNT
-  std::optional<std::string> frames;  // --frames LIST: a sequence, $F / $F4 in file names
-  std::optional<int> frame;           // the frame this run renders (one of --frames)
-  double noise = 0.0;                 // --noise: adaptive sampling to this binned relative RMSE
-  int noise_bin = 4;                  // --noise-bin
+  double time_limit = 0.0;               // --time: seconds, 0 = none
+  std::string resume;                    // --resume: the EXR to continue
+  std::vector<std::string> sets;         // --set PATH=VALUE
+  std::string res;                       // --res WxH
+  std::string region;                    // --region x0,y0,x1,y1
+  std::string samples;                   // --samples START:COUNT
+  std::optional<std::string> frames;     // --frames LIST: a sequence, $F / $F4 in file names
+  std::optional<int> frame;              // the frame this run renders (one of --frames)
+  double noise = 0.0;                    // --noise: adaptive sampling to this binned relative RMSE
+  int noise_bin = 4;                     // --noise-bin
+  std::optional<std::string> time_bins;  // --time-bins T0,T1,N: film.time_bins (a transient render)
   bool quiet = false;
 };
 
@@ -112,10 +113,10 @@ Scene resume_scene(const RenderArgs& args, FilmState* state, RenderOptions* opti
     throw Error(
         fmt::format("--resume: {}: the scene comes from the EXR's header; give no scene file", args.scene));
   if (args.integrator || args.seed || args.layers_given || !args.deep.empty() || !args.sets.empty() ||
-      !args.res.empty() || !args.region.empty() || !args.samples.empty())
+      !args.res.empty() || !args.region.empty() || !args.samples.empty() || args.time_bins)
     throw Error(
-        "--resume: --integrator, --seed, --layers, --deep, --set, --res, --region and --samples must be "
-        "those of the resumed render");
+        "--resume: --integrator, --seed, --layers, --deep, --set, --res, --region, --samples and --time-bins "
+        "must be those of the resumed render");
   ImageMetadata meta;
   read_exr(args.resume, &meta);
   *state = read_exr_state(args.resume);
@@ -137,6 +138,12 @@ Scene resume_scene(const RenderArgs& args, FilmState* state, RenderOptions* opti
   return scene;
 }
 
+// A transient render's time bins go beside the image: OUT.time.exr (docs/transient.md).
+std::filesystem::path transient_name(const std::filesystem::path& out) {
+  std::filesystem::path p = out;
+  return p.replace_extension(".time.exr");
+}
+
 // Writes the image (with its film state in an EXR), the preview and the deep image under `out`.
 void write_outputs(const RenderArgs& args, const RenderResult& r, const std::filesystem::path& out,
                    const std::function<std::filesystem::path(const std::string&)>& name) {
@@ -144,6 +151,7 @@ void write_outputs(const RenderArgs& args, const RenderResult& r, const std::fil
   write_image(out, r.image, r.metadata, args.exposure, false, state);
   if (!args.preview.empty()) write_image(name(args.preview), r.image, {}, args.exposure);
   if (!args.deep.empty() && !r.deep.offsets.empty()) write_deep_exr(name(args.deep), r.deep, r.metadata);
+  if (!r.transient.rgb.empty()) write_exr(transient_name(out), r.transient, r.metadata);
 }
 
 // --res WxH as two --set overrides.
@@ -158,6 +166,7 @@ std::vector<std::string> scene_overrides(const RenderArgs& args) {
     sets.push_back(fmt::format("camera.width={}", w));
     sets.push_back(fmt::format("camera.height={}", h));
   }
+  if (args.time_bins) sets.push_back("film.time_bins=[" + *args.time_bins + "]");
   return sets;
 }
 
@@ -332,6 +341,10 @@ void add_render_command(CLI::App& app, Action& action) {
   cmd->add_option("--deep-samples", args->deep_samples, "Most deep samples per pixel (default 32)")
       ->check(CLI::Range(1, kMaxDeepSamples))
       ->needs(deep);
+  cmd->add_option("--time-bins", args->time_bins,
+                  "A transient render (pathtrace): also write OUT.time.exr with the light binned by path "
+                  "length from the light, N bins over [T0, T1) (sets film.time_bins)")
+      ->type_name("T0,T1,N");
   cmd->add_option("--exposure", args->exposure, "Exposure in stops for PNG output")
       ->check(CLI::Range(-64.0, 64.0));
   cmd->add_option("--set", args->sets,

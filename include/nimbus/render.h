@@ -76,6 +76,10 @@ struct RenderResult {
   // The media's contribution along each camera ray (RenderOptions::deep_samples > 0; empty otherwise):
   // flattened, the RGBA of a transparent film.
   DeepImage deep;
+  // A transient render (scene film.time_bins; pathtrace only): the steady RGB(A) with the light binned by
+  // path length as layers time_under, time0000 .., time_over (render/time_film.h, docs/transient.md),
+  // summing to the steady image; empty otherwise.
+  Image transient;
   // The exact accumulation state at `spp`, for writing beside the image and resuming (not with deep).
   FilmState state;
   bool partial = false;           // cancelled before the requested spp: the image of the last whole pass

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <variant>
 #include <vector>
@@ -173,7 +174,7 @@ struct IntegratorSettings {
   std::string type = "pathtrace";
   int spp = 64;
   bool spp_given = false;  // the scene names its spp (else default_spp(type))
-  int max_events = 0;  // most scattering events on a path; 0 = unlimited
+  int max_events = 0;      // most scattering events on a path; 0 = unlimited
   uint64_t seed = 1;
   // The integrator's own fields as written (checked by the scene parser through the registry; each
   // integrator's header lists them).
@@ -190,9 +191,21 @@ inline const std::vector<std::string>& film_layer_names() {
 // What the image holds besides the beauty: `transparent` leaves the environment out of the colour and
 // the alpha (the environment is then a plate to be composited behind); `layers` names further EXR
 // layers from film_layer_names(), each at most once.
+// A transient render's time bins (film.time_bins [t0, t1, N]): N equal bins of total path length from
+// the light to the camera over [t0, t1), in scene units (c = 1). docs/transient.md.
+struct TimeBins {
+  double t0 = 0.0, t1 = 0.0;
+  int count = 0;
+};
+// At most this many time bins, and at most this many doubles (width x height x (N + 2) x 3) of
+// time-binned sums (4 GiB).
+inline constexpr int kMaxTimeBins = 100000;
+inline constexpr double kMaxTimeBinValues = 512.0 * 1024 * 1024;
+
 struct FilmSettings {
   bool transparent = false;
   std::vector<std::string> layers;
+  std::optional<TimeBins> time_bins;  // absent: a steady-state render only
 };
 
 struct Scene {

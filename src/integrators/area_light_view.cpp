@@ -23,7 +23,8 @@ bool has_visible_area_lights(const SceneContext& ctx) {
   return false;
 }
 
-Rgb visible_area_lights(const SceneContext& ctx, const Ray& ray, Rng& rng, double march_step) {
+Rgb visible_area_lights(const SceneContext& ctx, const Ray& ray, Rng& rng, double march_step,
+                        std::vector<TimedContribution>* timed) {
   Rgb L(0.0);
   for (const Light& light : ctx.lights) {
     double t = 0.0;
@@ -31,7 +32,9 @@ Rgb visible_area_lights(const SceneContext& ctx, const Ray& ray, Rng& rng, doubl
     if (!is_visible(light) ||
         !hit_area_light(light, ray.o, ray.d, std::numeric_limits<double>::infinity(), &t, &Le))
       continue;
-    L += Le * shadow_transmittance(ctx, ray.o, ray.d, t, rng, march_step);
+    const Rgb c = Le * shadow_transmittance(ctx, ray.o, ray.d, t, rng, march_step);
+    L += c;
+    if (timed) timed->push_back({t * length(ray.d), c, false});
   }
   return L;
 }

@@ -6,6 +6,7 @@
 
 #include "core/ray.h"
 #include "core/rng.h"
+#include "integrators/integrator.h"
 #include "scene/context.h"
 
 namespace nimbus {
@@ -13,8 +14,10 @@ namespace nimbus {
 // The radiance of the visible sphere and rectangle lights along a camera ray, each through the
 // transmittance in front of it (surfaces block it; media by ratio tracking, unbiased, or with
 // march_step > 0 a midpoint march as in shadow_transmittance). Lights do not occlude one another.
-// Consumes random numbers only for lights the ray meets.
-Rgb visible_area_lights(const SceneContext& ctx, const Ray& ray, Rng& rng, double march_step = 0.0);
+// Consumes random numbers only for lights the ray meets. A transient render (timed non-null) also records
+// each light's part with its distance from the camera (the ray's origin).
+Rgb visible_area_lights(const SceneContext& ctx, const Ray& ray, Rng& rng, double march_step = 0.0,
+                        std::vector<TimedContribution>* timed = nullptr);
 
 // True when some light of ctx is a visible area light (integrators skip the call otherwise).
 bool has_visible_area_lights(const SceneContext& ctx);

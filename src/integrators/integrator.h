@@ -24,6 +24,16 @@ struct DeepSegment {
   double alpha = 0.0;
 };
 
+// A part of a camera sample's radiance and the total length s of its path, from where the light left
+// its source (a light's sampled point, an emitting medium's point, or for a distant light the plane of
+// integrators/path_clock.h) to the camera: a transient render bins the parts by s (src/render/time_film.h).
+// `background`: the environment seen directly (a transparent film leaves it out).
+struct TimedContribution {
+  double s = 0.0;
+  Rgb L{0.0};
+  bool background = false;
+};
+
 // What one camera sample tells the film beyond its radiance: the compositing layers. Every field is a
 // one-sample estimate whose pixel mean is the layer (an integrator may fill it with an unbiased
 // stochastic estimate, e.g. an escape indicator for a transmittance). Radiances are parts of Li's
@@ -56,6 +66,9 @@ struct CameraSample {
   // null when no deep image is made.
   bool depth_wanted = true;
   std::vector<DeepSegment>* deep = nullptr;
+  // A transient render (film.time_bins; pathtrace only): where an integrator appends every part of Li
+  // with its path length; the parts sum to Li (up to rounding). Null otherwise.
+  std::vector<TimedContribution>* timed = nullptr;
 };
 
 class Integrator {

@@ -4,6 +4,7 @@
 #include "integrators/area_light_view.h"
 #include "integrators/camera_layers.h"
 #include "integrators/env_light.h"
+#include "integrators/path_clock.h"
 #include "integrators/surface_light.h"
 #include "integrators/tracking.h"
 #include "scene/lights.h"
@@ -90,7 +91,7 @@ nlohmann::json to_json(const PathTraceSettings& s) {
 }
 
 PathTracer::PathTracer(const SceneContext& context, int max_events, PathTraceSettings settings)
-    : ctx_(context), max_events_(max_events), s_(settings) {
+    : ctx_(context), max_events_(max_events), s_(settings), clock_reference_(context) {
   if (!s_.max_wide_scatters) return;
   for (int i = 0; i < ctx_.media.count(); ++i) {
     const Phase& phase = ctx_.media.phase(i);
@@ -108,7 +109,9 @@ double PathTracer::split_weight(int medium, double mu, int wide) const {
   return (wide + 1 <= K ? share : 0.0) + (wide <= K ? 1.0 - share : 0.0);
 }
 
-Rgb PathTracer::direct_light(const Vec3& p, const Vec3& d, int medium, int wide_scatters, Rng& rng) const {
+Rgb PathTracer::direct_light(const Vec3& p, const Vec3& d, int medium, int wide_scatters, Rng& rng,
+                             const Rgb& beta, const PathClock& clock) const {
+  const size_t timed_from = clock.mark();
   const Phase& phase = ctx_.media.phase(medium);
   Rgb L(0.0);
   // Lights with a sampled direction: weight = radiance / pdf.
@@ -118,7 +121,9 @@ Rgb PathTracer::direct_light(const Vec3& p, const Vec3& d, int medium, int wide_
     if (!sample_light(light, p, u1, u2, &ls)) continue;
     const double f = phase_eval(phase, dot(d, ls.wi)) * split_weight(medium, dot(d, ls.wi), wide_scatters);
     if (f <= 0.0) continue;
-    L += ls.weight * shadow_transmittance(ctx_, p, ls.wi, ls.distance, rng) * f;
+    const Rgb c = ls.weight * shadow_transmittance(ctx_, p, ls.wi, ls.distance, rng) * f;
+    L += c;
+    clock.record(clock.connection(p, ls), c);
   }
   // The constant environment through a phase-sampled direction: f / pdf = 1.
   constexpr double kInf = std::numeric_limits<double>::infinity();
@@ -126,7 +131,9 @@ Rgb PathTracer::direct_light(const Vec3& p, const Vec3& d, int medium, int wide_
     const double u1 = rng.uniform(), u2 = rng.uniform();
     const Vec3 wi = phase_sample(phase, d, u1, u2);
     const Rgb T = shadow_transmittance(ctx_, p, wi, kInf, rng);
-    L += ctx_.environment * T * split_weight(medium, dot(d, wi), wide_scatters);
+    const Rgb c = ctx_.environment * T * split_weight(medium, dot(d, wi), wide_scatters);
+    L += c;
+    clock.record(clock.distant.distance(p, wi), c);
   }
   // The environment image: a map-sampled and a phase-sampled direction by MIS (integrators/env_light.h).
   if (ctx_.env_map) {
@@ -139,7 +146,8 @@ Rgb PathTracer::direct_light(const Vec3& p, const Vec3& d, int medium, int wide_
         [&](const Vec3& wi) { return phase_eval(phase, dot(d, wi)); },
         [&](const Vec3& wi) { return shadow_transmittance(ctx_, p, wi, kInf, rng); });
   }
-  return L;
+  clock.settle(timed_from, beta);
+  return beta * L;
 }
 
 bool PathTracer::collide(const MediumPoint& mp, double maj, Rgb& beta, Rng& rng, int* scatter_medium) const {
@@ -188,6 +196,7 @@ Rgb PathTracer::Li(const Ray& ray, Rng& rng, CameraSample* sample) const {
   int wide = 0;  // wide scatters so far (with a wide-scatter limit)
   MediumPoint mp;
   FirstFlight first{ray, sample != nullptr};
+  PathClock clock{sample ? sample->timed : nullptr, clock_reference_};
   for (int events = 0;; ++events) {
     // The free flight ends at the first surface, if any.
     SurfaceHit hit;
@@ -198,7 +207,7 @@ Rgb PathTracer::Li(const Ray& ray, Rng& rng, CameraSample* sample) const {
     const bool escaped = track(ctx_.majorants, o, d, hit.t, rng, [&](const Vec3& p, double maj) {
       ctx_.media.eval(p, &mp);
       // Emission at every tentative collision, j / majorant: an unbiased estimate of int T j dt.
-      if (ctx_.media.emits()) L += beta * mp.emission / maj;
+      if (ctx_.media.emits()) clock.add(L, beta * mp.emission / maj, clock.from(o, p));
       if (!collide(mp, maj, beta, rng, &scatter_medium)) return first.null_collision(events, p);
       scatter_p = p;
       return false;
@@ -209,7 +218,8 @@ Rgb PathTracer::Li(const Ray& ray, Rng& rng, CameraSample* sample) const {
         record_surface_hit(ctx_, hit, beta, sample);
       }
       const Rgb L_before = L;
-      const bool goes_on = reflect(hit, L, beta, wide, rng);
+      clock.walk(o, hit.p);
+      const bool goes_on = reflect(hit, L, beta, wide, rng, clock);
       if (events == 0) first.direct = L - L_before;
       if (!goes_on || (max_events_ > 0 && events + 1 >= max_events_)) break;
       d = cosine_direction(hit.ns, rng.uniform(), rng.uniform());
@@ -218,13 +228,14 @@ Rgb PathTracer::Li(const Ray& ray, Rng& rng, CameraSample* sample) const {
     } else if (escaped) {
       if (events == 0) first.end(true, beta, scatter_p);
       // Only camera rays see the environment directly; later escapes were counted by NEE.
-      if (events == 0 && ctx_.has_environment) L += beta * ctx_.environment_radiance(d);
+      if (events == 0 && ctx_.has_environment) clock.background(L, beta * ctx_.environment_radiance(d), o, d);
       break;
     } else {
       if (events == 0) first.end(false, beta, scatter_p);
       if (scatter_medium < 0 || max_component(beta) <= 0.0) break;
       // Next-event estimation at the scattering vertex.
-      const Rgb L_direct = beta * direct_light(scatter_p, d, scatter_medium, wide, rng);
+      clock.walk(o, scatter_p);
+      const Rgb L_direct = direct_light(scatter_p, d, scatter_medium, wide, rng, beta, clock);
       L += L_direct;
       if (events == 0) first.direct = L_direct;
       if (max_events_ > 0 && events + 1 >= max_events_) break;
@@ -234,7 +245,7 @@ Rgb PathTracer::Li(const Ray& ray, Rng& rng, CameraSample* sample) const {
 
     if (!survives_roulette(events, beta, rng)) break;
   }
-  const Rgb Le = visible_area_lights(ctx_, ray, rng);  // what the camera sees of lights (else NEE only)
+  const Rgb Le = visible_area_lights(ctx_, ray, rng, 0.0, clock.out);  // lights the camera sees
   L += Le, first.direct += Le;
   if (sample) fill_camera_sample(ctx_, first, L, sample);
   return L;
@@ -255,13 +266,17 @@ bool PathTracer::scatter(int medium, Vec3& d, int& wide, Rng& rng) const {
   return true;
 }
 
-bool PathTracer::reflect(const SurfaceHit& hit, Rgb& L, Rgb& beta, int& wide, Rng& rng) const {
+bool PathTracer::reflect(const SurfaceHit& hit, Rgb& L, Rgb& beta, int& wide, Rng& rng,
+                         const PathClock& clock) const {
   const Material& material = ctx_.surfaces.material(hit.surface);
   const auto* diffuse = std::get_if<DiffuseMaterial>(&material);
   if (!diffuse) return false;  // a holdout: black, and the path ends
   // A diffuse reflection is a wide scatter (with a wide-scatter limit).
   if (!splits_.empty() && ++wide > *s_.max_wide_scatters) return false;
-  L += beta * surface_radiance(ctx_, hit, rng, nullptr);  // direct light and the environment
+  // Direct light and the environment (a transient render: each part with its light connection's length).
+  const PathClock* timed = clock.on() ? &clock : nullptr;
+  L += beta *
+       clock.settled(beta, [&] { return surface_radiance(ctx_, hit, rng, nullptr, nullptr, 0.0, timed); });
   beta *= diffuse->albedo;
   return max_component(beta) > 0.0;
 }

@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "integrators/integrator.h"
+#include "integrators/path_clock.h"
 #include "transport/phase_split.h"
 
 namespace nimbus {
@@ -49,13 +50,16 @@ class PathTracer final : public Integrator {
  private:
   // Next-event estimate at a scattering vertex p of medium `medium`, the path travelling along d.
   // wide_scatters: wide scatters on the path so far (only used with a wide-scatter limit).
-  Rgb direct_light(const Vec3& p, const Vec3& d, int medium, int wide_scatters, Rng& rng) const;
+  // Returns it times the path throughput beta. A transient render's clock records each light's part with
+  // its connection's length.
+  Rgb direct_light(const Vec3& p, const Vec3& d, int medium, int wide_scatters, Rng& rng, const Rgb& beta,
+                   const PathClock& clock) const;
   // Samples the continuation after a scatter in `medium`: d becomes the new direction. False when the
   // path ends (over the wide-scatter limit).
   bool scatter(int medium, Vec3& d, int& wide, Rng& rng) const;
   // The path meets surface hit: adds its direct light to L and its albedo to beta. False when the path
   // ends there (a holdout, over the wide-scatter limit, or black).
-  bool reflect(const SurfaceHit& hit, Rgb& L, Rgb& beta, int& wide, Rng& rng) const;
+  bool reflect(const SurfaceHit& hit, Rgb& L, Rgb& beta, int& wide, Rng& rng, const PathClock& clock) const;
   // One collision of delta tracking with the media at a point (mp) under majorant maj, by history-aware
   // spectral tracking: updates the throughput beta. Returns false for a null collision (tracking goes
   // on), true when the flight ends here: a real scatter in medium *scatter_medium, or the path absorbed
@@ -68,6 +72,7 @@ class PathTracer final : public Integrator {
   int max_events_ = 0;
   PathTraceSettings s_;
   std::vector<std::unique_ptr<PhaseSplit>> splits_;
+  DistantReference clock_reference_;  // a transient render's plane for distant lights
 };
 
 }  // namespace nimbus

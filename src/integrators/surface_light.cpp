@@ -28,7 +28,7 @@ Rgb shadow_transmittance(const SceneContext& ctx, const Vec3& p, const Vec3& w, 
 }
 
 Rgb surface_direct_light(const SceneContext& ctx, const SurfaceHit& hit, const Rgb& albedo, Rng& rng,
-                         double march_step) {
+                         double march_step, const PathClock* timed) {
   Rgb E(0.0);  // cosine-weighted irradiance / pi
   for (const Light& light : ctx.lights) {
     LightSample ls;
@@ -37,16 +37,19 @@ Rgb surface_direct_light(const SceneContext& ctx, const SurfaceHit& hit, const R
     const double cos_theta = dot(hit.ns, ls.wi);
     if (cos_theta <= 0.0 || dot(hit.ng, ls.wi) <= 0.0) continue;
     const Vec3 o = SceneSurfaces::offset(hit, ls.wi);
-    E += ls.weight * shadow_transmittance(ctx, o, ls.wi, ls.distance, rng, march_step) * (cos_theta / kPi);
+    const Rgb e =
+        ls.weight * shadow_transmittance(ctx, o, ls.wi, ls.distance, rng, march_step) * (cos_theta / kPi);
+    E += e;
+    if (timed) timed->record(timed->connection(hit.p, ls), albedo * e);
   }
   return albedo * E;
 }
 
 Rgb surface_radiance(const SceneContext& ctx, const SurfaceHit& hit, Rng& rng, const GatherFn* gather,
-                     Rgb* direct_part, double march_step) {
+                     Rgb* direct_part, double march_step, const PathClock* timed) {
   const auto* diffuse = std::get_if<DiffuseMaterial>(&ctx.surfaces.material(hit.surface));
   if (!diffuse) return Rgb(0.0);  // a holdout
-  Rgb L = surface_direct_light(ctx, hit, diffuse->albedo, rng, march_step);
+  Rgb L = surface_direct_light(ctx, hit, diffuse->albedo, rng, march_step, timed);
   if (direct_part) *direct_part = L;
   if (!gather && !ctx.has_environment) return L;
   // The environment image by MIS (integrators/env_light.h); a gathered ray then leaves it out where it
@@ -61,8 +64,10 @@ Rgb surface_radiance(const SceneContext& ctx, const SurfaceHit& hit, Rng& rng, c
     const EnvMapTakenHere taken(ctx.env_map != nullptr);
     return L + diffuse->albedo * (*gather)(Ray{o, wi});
   }
-  return L + diffuse->albedo * ctx.environment *
-                 shadow_transmittance(ctx, o, wi, std::numeric_limits<double>::infinity(), rng, march_step);
+  const Rgb env = diffuse->albedo * ctx.environment *
+                  shadow_transmittance(ctx, o, wi, std::numeric_limits<double>::infinity(), rng, march_step);
+  if (timed) timed->record(timed->distant.distance(hit.p, wi), env);
+  return L + env;
 }
 
 Rgb surface_env_map_light(const SceneContext& ctx, const SurfaceHit& hit, Rng& rng, double march_step) {

@@ -5,6 +5,7 @@
 #include <functional>
 
 #include "integrators/integrator.h"
+#include "integrators/path_clock.h"
 #include "scene/surfaces.h"
 
 namespace nimbus {
@@ -26,8 +27,9 @@ Rgb shadow_transmittance(const SceneContext& ctx, const Vec3& p, const Vec3& w, 
 // (albedo / pi) times the cosine-weighted irradiance at a diffuse surface point from every directional,
 // point, spot and area light (light sampling, one sample each), through shadow_transmittance. hit.ns
 // faces the viewer; the surface is two-sided, lit on the viewer's side only.
+// A transient render (timed non-null) also records each light's part with its connection's length.
 Rgb surface_direct_light(const SceneContext& ctx, const SurfaceHit& hit, const Rgb& albedo, Rng& rng,
-                         double march_step = 0.0);
+                         double march_step = 0.0, const PathClock* timed = nullptr);
 
 // The radiance that leaves a surface point towards the ray that found it, for the integrators that march
 // the camera ray (single, octave, mfs): 0 for a holdout; for a diffuse surface its direct light plus
@@ -37,9 +39,10 @@ Rgb surface_direct_light(const SceneContext& ctx, const SurfaceHit& hit, const R
 // gather (nullptr), only the environment through the media is gathered. An environment image is taken by
 // surface_env_map_light (MIS) in both cases, and the gathered ray's own escape then leaves it out.
 using GatherFn = std::function<Rgb(const Ray&)>;
-// *direct_part (when given) receives the lights' direct part of the result.
+// *direct_part (when given) receives the lights' direct part of the result. A transient render (timed
+// non-null; no gather, no environment image) also records each part with its light connection's length.
 Rgb surface_radiance(const SceneContext& ctx, const SurfaceHit& hit, Rng& rng, const GatherFn* gather,
-                     Rgb* direct_part = nullptr, double march_step = 0.0);
+                     Rgb* direct_part = nullptr, double march_step = 0.0, const PathClock* timed = nullptr);
 
 // The light at the end of a marched ray (direction d), seen through its transmittance T: the surface it
 // ends on (hit, through surface_radiance with `gather`; its layers recorded into a non-null sample, with a

@@ -156,8 +156,30 @@ IntegratorSettings parse_integrator(const nlohmann::json& j, JsonObject o) {
   return s;
 }
 
-FilmSettings parse_film(JsonObject o) {
+// film.time_bins [t0, t1, N]: 0 <= t0 < t1 finite, 1 <= N <= kMaxTimeBins, and the time-binned sums of a
+// width x height image within kMaxTimeBinValues.
+TimeBins parse_time_bins(JsonObject& o, const Camera& camera) {
+  const nlohmann::json& v = o.raw("time_bins");
+  const char* form = "must be [t0, t1, N]: N equal bins of path length over [t0, t1), 0 <= t0 < t1, N >= 1";
+  if (!v.is_array() || v.size() != 3 || !v[0].is_number() || !v[1].is_number() || !v[2].is_number())
+    o.fail("time_bins", form);
+  TimeBins b{v[0].get<double>(), v[1].get<double>(), 0};
+  if (!(b.t0 >= 0.0 && b.t1 > b.t0 && std::isfinite(b.t1))) o.fail("time_bins", form);
+  const double n = v[2].get<double>();
+  if (!(n >= 1.0 && n <= kMaxTimeBins && n == std::floor(n)))
+    o.fail("time_bins", fmt::format("N (the third entry) must be an integer in [1, {}]", kMaxTimeBins));
+  b.count = int(n);
+  const double values = double(camera.width) * camera.height * (b.count + 2) * 3;
+  if (values > kMaxTimeBinValues)
+    o.fail("time_bins", fmt::format("{} bins of a {}x{} image need {:.1f} GiB of sums (at most {:.0f})",
+                                    b.count, camera.width, camera.height, values * 8 / (1 << 30),
+                                    kMaxTimeBinValues * 8 / (1 << 30)));
+  return b;
+}
+
+FilmSettings parse_film(JsonObject o, const Camera& camera) {
   FilmSettings f;
+  if (o.has("time_bins")) f.time_bins = parse_time_bins(o, camera);
   f.transparent = o.boolean("transparent", f.transparent);
   if (o.has("layers")) {
     const nlohmann::json& layers = o.raw("layers");
@@ -204,7 +226,7 @@ Scene parse_scene(const nlohmann::json& doc, const std::string& name, const std:
   }
   if (root.has("integrator"))
     scene.integrator = parse_integrator(doc["integrator"], root.object("integrator"));
-  if (root.has("film")) scene.film = parse_film(root.object("film"));
+  if (root.has("film")) scene.film = parse_film(root.object("film"), scene.camera);
   root.finish();
   scene.source = doc;
   return scene;

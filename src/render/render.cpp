@@ -24,6 +24,7 @@
 #include "render/deep.h"
 #include "render/film.h"
 #include "render/film_layers.h"
+#include "render/time_film.h"
 
 namespace nimbus {
 
@@ -71,6 +72,11 @@ IntegratorSettings resolve_settings(const Scene& scene, const RenderOptions& opt
                     r->x0, r->y0, r->x1, r->y1, scene.camera.width, scene.camera.height));
   if (options.deep_samples < 0 || options.deep_samples > kMaxDeepSamples)
     throw Error(fmt::format("deep samples must be between 1 and {} (0: no deep image)", kMaxDeepSamples));
+  if (const auto& t = scene.film.time_bins; t && settings.type != "pathtrace")
+    throw Error(fmt::format("film.time_bins: only the pathtrace integrator makes transient renders (not {})",
+                            settings.type));
+  if (scene.film.time_bins && options.resume)
+    throw Error("film.time_bins: a transient render cannot be resumed (render it in one go)");
   return settings;
 }
 
@@ -94,7 +100,8 @@ struct PixelTargets {
   const FilmLayers& layers;
   int deep_samples = 0;                               // 0: no deep image
   std::vector<std::vector<DeepSample>>* deep_pixels;  // per pixel, when deep_samples > 0
-  int adaptive_layer = -1;  // adaptive sampling: the film layer of kAdaptiveLayer (render/adaptive.h)
+  int adaptive_layer = -1;        // adaptive sampling: the film layer of kAdaptiveLayer (render/adaptive.h)
+  TimeFilm* time_film = nullptr;  // a transient render (film.time_bins)
 };
 
 // Samples of pixel (x, y) into the film. Positions in the pixel: the R2 sequence (Roberts 2018), shifted
@@ -109,6 +116,7 @@ int64_t render_pixel(const Integrator& integrator, const PinholeCamera& camera,
   const double ux = shift.uniform(), uy = shift.uniform();
   int64_t bad = 0;
   thread_local std::vector<DeepSegment> segments, sample_segments;
+  thread_local std::vector<TimedContribution> timed;
   segments.clear();
   s0 += to.sample_start;
   s1 += to.sample_start;
@@ -121,14 +129,17 @@ int64_t render_pixel(const Integrator& integrator, const PinholeCamera& camera,
     sample.depth_wanted = to.layers.depth_wanted();
     sample_segments.clear();
     if (to.deep_samples > 0) sample.deep = &sample_segments;
+    timed.clear();
+    if (to.time_film) sample.timed = &timed;
     const uint64_t rng_start = rng.state();
     const Rgb L = integrator.Li(camera.generate_ray(x + jx, y + jy), rng, &sample);
     const double* rgb = to.film.sums(0, x - to.x0, y - to.y0);
     const double before = to.adaptive_layer >= 0 ? luminance(Rgb(rgb[0], rgb[1], rgb[2])) : 0.0;
     if (!to.layers.add(to.film, x - to.x0, y - to.y0, L, sample)) {
       ++bad;
-      continue;  // a dropped sample adds nothing to the deep pixel either
+      continue;  // a dropped sample adds nothing to the deep pixel (or the time bins) either
     }
+    if (to.time_film) to.time_film->add(x - to.x0, y - to.y0, timed);
     if (to.adaptive_layer >= 0) {  // the luminance the film took (less a transparent film's background)
       const double lum = luminance(Rgb(rgb[0], rgb[1], rgb[2])) - before;
       const double a[kAdaptiveChannels] = {lum * lum, double(rng.draws_since(rng_start))};
@@ -230,6 +241,7 @@ ImageMetadata render_metadata(const Scene& scene, const RenderResult& result, co
   rendered["integrator"] = result.settings;
   if (film.transparent || !film.layers.empty() || rendered.contains("film"))
     rendered["film"] = {{"transparent", film.transparent}, {"layers", film.layers}};
+  if (const auto& t = film.time_bins) rendered["film"]["time_bins"] = {t->t0, t->t1, t->count};
   std::error_code ec;
   const std::filesystem::path file =
       scene.file.empty() ? scene.file : std::filesystem::absolute(scene.file, ec);
@@ -306,9 +318,21 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
           fmt::format("resume: the image has {} spp, more than the {} asked for", done, settings.spp));
   }
   std::vector<std::vector<DeepSample>> deep_pixels(options.deep_samples > 0 ? size_t(W) * size_t(H) : 0);
-  const PixelTargets targets{
-      film,         window.x0,     window.y0, options.sample_start, layers, options.deep_samples,
-      &deep_pixels, adaptive_layer};
+  if (scene.film.time_bins && context->env_map)
+    throw Error(
+        "film.time_bins: an environment image is not supported in a transient render (constant "
+        "environments, suns, point, spot and area lights are)");
+  std::optional<TimeFilm> time_film;
+  if (scene.film.time_bins) time_film.emplace(W, H, *scene.film.time_bins, film_settings.transparent);
+  const PixelTargets targets{film,
+                             window.x0,
+                             window.y0,
+                             options.sample_start,
+                             layers,
+                             options.deep_samples,
+                             &deep_pixels,
+                             adaptive_layer,
+                             time_film ? &*time_film : nullptr};
 
   bool first = true;
   auto cancelled = [&] { return options.cancel && options.cancel->load(std::memory_order_relaxed); };
@@ -336,9 +360,11 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
       next = int(std::min<double>(next, done + std::floor(fit)));
     }
     const FilmState before = stoppable ? film.state(done) : FilmState{};
+    const std::optional<TimeFilm> time_before = stoppable ? time_film : std::nullopt;
     const auto pass_start = Clock::now();
     if (!render_pass(pc, arena, done, next)) {
-      film.restore(before);  // the image of the last whole pass
+      film.restore(before);
+      if (time_before) time_film = time_before;  // the image of the last whole pass
       (cancelled() ? result.partial : result.time_limited) = true;
       break;
     }
@@ -366,9 +392,11 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
     pc.target = &plan.target;
     pc.total = pc.done + plan.new_samples;
     const FilmState before = stoppable ? film.state(done) : FilmState{};
+    const std::optional<TimeFilm> time_before = stoppable ? time_film : std::nullopt;
     const auto pass_start = Clock::now();
     if (!render_pass(pc, arena, 0, 0)) {
       film.restore(before);
+      if (time_before) time_film = time_before;
       (cancelled() ? result.partial : result.time_limited) = true;
       break;
     }
@@ -397,6 +425,11 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
   result.seconds = seconds_since(start);
   result.settings = resolved_block(settings, *integrator);
   result.metadata = render_metadata(scene, result, film_settings);
+  if (time_film) {  // the steady image with the time bins as layers (render/time_film.h)
+    for (auto& kv : time_film->metadata()) result.metadata.push_back(kv);
+    result.transient = result.image;
+    result.transient.channels = time_film->resolve(film);
+  }
   if (options.region)
     result.metadata.emplace_back("nimbus/region",
                                  fmt::format("{},{},{},{}", window.x0, window.y0, window.x1, window.y1));
