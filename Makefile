@@ -3,7 +3,7 @@
 #               out/demo.{exr,png} and with pathtrace in the same time to out/demo_pathtrace.{exr,png}
 #   make test   installs missing Debian packages, builds, runs the whole suite through ctest
 # Also: make (build only), make python (the Python module in build/python/: docs/python.md),
-# make test-fast (no statistical tests), make asan (sanitizer build + fast tests),
+# make test-fast (no statistical tests), make asan (clang sanitizer build build-san/ + fast tests),
 # make fuzz-smoke (libFuzzer targets, 60 s each), make fuzz FUZZ_SECONDS=N (N s each): docs/reliability.md.
 # make farm-test (as root: a one-node Slurm cluster renders a sequence, a split frame, a killed task): docs/farm.md.
 BUILD ?= build
@@ -45,9 +45,16 @@ test-fast: deps
 	@$(MAKE) --no-print-directory build
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS) -LE slow
 
-asan: deps
-	@$(MAKE) --no-print-directory build BUILD=build-asan CMAKE_FLAGS="-DNIMBUS_SANITIZE=ON -DNIMBUS_BUILD_BENCH=OFF"
-	cd build-asan && ctest --output-on-failure -j $(JOBS) -LE slow -E '$(ASAN_SKIP)'
+# One sanitizer build, build-san/ (clang-14, ASan + UBSan, libFuzzer coverage), serves both the fast
+# suite under the sanitizers and the fuzz targets: the library is compiled once for both.
+SAN_BUILD ?= build-san
+$(SAN_BUILD)/build.ninja:
+	cmake -S . -B $(SAN_BUILD) -G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_COMPILER=clang++-14 \
+	  -DNIMBUS_SANITIZE=ON -DNIMBUS_FUZZ=ON -DNIMBUS_BUILD_BENCH=OFF -DNIMBUS_PYTHON=OFF
+
+asan: deps $(SAN_BUILD)/build.ninja
+	cmake --build $(SAN_BUILD) -j $(JOBS) --target nimbus_fast_tests nimbus_cli
+	cd $(SAN_BUILD) && ctest --output-on-failure -j $(JOBS) -LE slow -E '$(ASAN_SKIP)'
 
 bench: build
 	$(BUILD)/bin/bench_render
@@ -58,24 +65,20 @@ farm-test: deps
 	@$(MAKE) --no-print-directory build
 	timeout 600 ./scripts/farm/farm_test.sh $(BUILD)
 
-# libFuzzer targets (fuzz/): clang-14, ASan + UBSan, in build-fuzz/. See docs/reliability.md.
-build-fuzz/build.ninja:
-	cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_COMPILER=clang++-14 \
-	  -DNIMBUS_FUZZ=ON -DBUILD_TESTING=OFF -DNIMBUS_BUILD_BENCH=OFF
-
-fuzz-build: deps build-fuzz/build.ninja
-	cmake --build build-fuzz -j $(JOBS) --target scene_fuzz vdb_fuzz cli_fuzz mesh_fuzz
+# libFuzzer targets (fuzz/), in the sanitizer build. See docs/reliability.md.
+fuzz-build: deps $(SAN_BUILD)/build.ninja
+	cmake --build $(SAN_BUILD) -j $(JOBS) --target scene_fuzz vdb_fuzz cli_fuzz mesh_fuzz
 
 fuzz-smoke: fuzz-build
-	FUZZ_SEED=1 fuzz/run.sh 60
+	FUZZ_SEED=1 BUILD_FUZZ=$(SAN_BUILD) fuzz/run.sh 60
 
 fuzz: fuzz-build
-	fuzz/run.sh $(FUZZ_SECONDS)
+	BUILD_FUZZ=$(SAN_BUILD) fuzz/run.sh $(FUZZ_SECONDS)
 
 # Regenerates fuzz/data/tiny.{vdb,nvdb} and the volume seeds in fuzz/corpus/vdb/ (committed).
 fuzz-seeds: fuzz-build
-	cmake --build build-fuzz -j $(JOBS) --target make_seeds
-	ASAN_OPTIONS=detect_leaks=0 build-fuzz/bin/make_seeds fuzz/data fuzz/corpus/vdb
+	cmake --build $(SAN_BUILD) -j $(JOBS) --target make_seeds
+	ASAN_OPTIONS=detect_leaks=0 $(SAN_BUILD)/bin/make_seeds fuzz/data fuzz/corpus/vdb
 
 clean:
-	rm -rf $(BUILD) build-asan build-fuzz
+	rm -rf $(BUILD) $(SAN_BUILD)

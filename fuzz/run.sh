@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
-# Runs the libFuzzer targets built in build-fuzz/ (make fuzz-build) for SECONDS each, one after the
+# Runs the libFuzzer targets built in build-san/ (make fuzz-build) for SECONDS each, one after the
 # other: make fuzz-smoke runs it with 60 s, make fuzz FUZZ_SECONDS=N with N. New inputs go to
-# build-fuzz/corpus/<target>/ (the committed seeds in fuzz/corpus/<target>/ are only read); a crash,
-# leak, timeout or out-of-memory input is written to build-fuzz/artifacts/<target>/ and fails the run.
+# build-san/corpus/<target>/ (the committed seeds in fuzz/corpus/<target>/ are only read); a crash,
+# leak, timeout or out-of-memory input is written to build-san/artifacts/<target>/ and fails the run.
 # Usage: [FUZZ_SEED=N] fuzz/run.sh SECONDS [TARGET...]   (targets: scene vdb cli mesh; default all)
 # FUZZ_SEED: libFuzzer's -seed (default 0: a random seed); make fuzz-smoke passes 1 so that CI repeats the
 # same mutations from run to run (fork-mode job timing still varies), make fuzz leaves it random.
@@ -12,7 +12,7 @@ seconds=${1:?usage: fuzz/run.sh SECONDS [TARGET...]}
 shift
 targets=("$@")
 [ ${#targets[@]} -eq 0 ] && targets=(scene vdb cli mesh)
-BUILD_FUZZ=${BUILD_FUZZ:-build-fuzz}
+BUILD_FUZZ=${BUILD_FUZZ:-build-san}
 export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1}
 export LSAN_OPTIONS=${LSAN_OPTIONS:-suppressions=$PWD/fuzz/lsan.supp}
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Replays every input a fuzz target saved under build-fuzz/artifacts/TARGET/ and sorts it by the first
+# Replays every input a fuzz target saved under build-san/artifacts/TARGET/ and sorts it by the first
 # stack frame that is not the sanitizer, libFuzzer, libc or libstdc++: inside libopenvdb.so is a
 # third-party OpenVDB 10.0 defect (docs/reliability.md lists the known ones), anything else is a
 # nimbus bug and makes this script exit 1.
@@ -7,7 +7,7 @@
 set -uo pipefail
 cd "$(dirname "$0")/.."
 t=${1:?usage: fuzz/triage.sh TARGET}
-BUILD_FUZZ=${BUILD_FUZZ:-build-fuzz}
+BUILD_FUZZ=${BUILD_FUZZ:-build-san}
 export ASAN_OPTIONS=detect_leaks=1:alloc_dealloc_mismatch=0
 export LSAN_OPTIONS=suppressions=$PWD/fuzz/lsan.supp
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
