@@ -38,9 +38,8 @@ struct Image {  // linear RGB, row-major, row 0 = top, 3 floats per pixel
 // A film sum: a signed 128-bit fixed-point number, its value sum * 2^-fraction_bits. Every sample enters
 // the sum rounded once to that grid (src/render/film.h), so sums add exactly: associatively, in any order.
 __extension__ typedef __int128 FilmSum;
-// A sample enters a film sum within +-2^kFilmSampleBits grid steps, so the sums of up to 2^24 samples
-// (kMaxSpp) stay within +-2^126 and never overflow.
-inline constexpr int kFilmSampleBits = 102;
+// A sample enters a film sum within +-2^kFilmSampleBits grid steps; a sum saturates at +-(2^127 - 1).
+inline constexpr int kFilmSampleBits = 126;
 
 // A render's exact accumulation state: per film layer the fixed-point sums of its samples (`channels` per
 // pixel, row-major, on a grid of 2^-fraction_bits), and each pixel's sample count. Written beside the

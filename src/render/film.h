@@ -9,8 +9,10 @@
 // --samples) equal the sum made sample by sample bit for bit. The grid of 2^-64 is far finer than the
 // float rounding of the pixel values a film sees (pixel means of 1e-10 and up come out as double sums
 // gave them, to a float ulp); a sample below half a step (2.7e-20) adds 0.
-// A value beyond +-2^(kFilmSampleBits - fraction_bits) (2.7e11 on the 2^-64 grid) does not fit: the beauty
-// drops such a sample as it drops a non-finite one, other layers take it saturated to that bound.
+// A value beyond +-2^(kFilmSampleBits - fraction_bits) (4.6e18 on the 2^-64 grid) does not fit: the beauty
+// drops such a sample as it drops a non-finite one, other layers take it saturated to that bound. A sum
+// that would leave +-(2^127 - 1) (9.2e18 on the 2^-64 grid) saturates there: that pixel is then wrong,
+// and no longer exact under merges, but never undefined.
 #pragma once
 
 #include <bit>
@@ -46,10 +48,13 @@ inline FilmSum film_round(double x) {
   return bits >> 63 ? -q : q;
 }
 
-// a + b, wrapping instead of overflowing (the sample bound keeps real sums far from it; never UB).
+// a + b, saturated at +-(2^127 - 1) (never UB).
 inline FilmSum film_add(FilmSum a, FilmSum b) {
   __extension__ typedef unsigned __int128 Bits;
-  return FilmSum(Bits(a) + Bits(b));
+  FilmSum s;
+  if (!__builtin_add_overflow(a, b, &s)) return s;
+  const FilmSum max = FilmSum(~Bits(0) >> 1);
+  return b > 0 ? max : -max;
 }
 
 class Film {
@@ -105,8 +110,8 @@ class Film {
   void restore(const FilmState& state);
 
  private:
-  static constexpr double kLimit = 0x1p102;  // 2^kFilmSampleBits grid steps
-  static_assert(kFilmSampleBits == 102);
+  static constexpr double kLimit = 0x1p126;  // 2^kFilmSampleBits grid steps
+  static_assert(kFilmSampleBits == 126);
   struct Layer {
     std::string name;
     int channels = 0;

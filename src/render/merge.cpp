@@ -242,7 +242,7 @@ MergeResult merge_renders(const std::vector<std::filesystem::path>& files) {
           const size_t k = size_t(st.layers[l].channels);
           FilmSum* out = &st.layers[l].sums[k * dst];
           const FilmSum* add = &from[l]->sums[k * src];
-          for (size_t c = 0; c < k; ++c)  // read_exr_state bounds each sum; a sum of too many would not fit
+          for (size_t c = 0; c < k; ++c)  // sums that would leave 128 bits are refused
             if (__builtin_add_overflow(out[c], add[c], &out[c]))
               throw Error(fmt::format("{}: the film sums overflow at pixel ({}, {})", in.file, x, y));
         }

@@ -38,6 +38,7 @@ TEST(ExactFilm, RoundsToTheNearestIntegerTiesToEven) {
   // Beyond 2^52 every double is an integer: converted exactly (an independent 2^70 + 2^18).
   EXPECT_EQ(film_round(0x1p70 + 0x1p18), (FilmSum(1) << 70) + (FilmSum(1) << 18));
   EXPECT_EQ(film_round(-0x1p102), -(FilmSum(1) << 102));
+  EXPECT_EQ(film_round(0x1p126), FilmSum(1) << 126);
   // Against the C library's rounding (ties to even in the default mode) over many magnitudes.
   std::mt19937_64 gen(3);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
@@ -88,7 +89,7 @@ TEST(ExactFilm, SumsAreExactAndIndependentOfTheOrder) {
 TEST(ExactFilm, ValuesBeyondTheRangeAreDroppedOrSaturated) {
   Film film(2, 1);
   const int depth = film.add_layer("depth", 1);
-  const double limit = std::ldexp(1.0, kFilmSampleBits - kFilmFractionBits);  // 2^38
+  const double limit = std::ldexp(1.0, kFilmSampleBits - kFilmFractionBits);  // 2^62
   EXPECT_TRUE(film.add_sample(0, 0, Rgb(limit, -limit, 1.0)));
   EXPECT_FALSE(film.add_sample(0, 0, Rgb(1.0, 2.0 * limit, 1.0)));  // dropped, counted
   EXPECT_FALSE(film.add_sample(0, 0, Rgb(INFINITY, 0.0, 0.0)));
@@ -97,8 +98,10 @@ TEST(ExactFilm, ValuesBeyondTheRangeAreDroppedOrSaturated) {
   EXPECT_EQ(film.sum(0, 0, 0, 1), -limit);
   const double big = 1e300, nan = NAN;
   film.add(depth, 1, 0, &big);  // saturated at the bound
-  film.add(depth, 1, 0, &big);
+  EXPECT_EQ(film.sum(depth, 1, 0, 0), limit);
+  film.add(depth, 1, 0, &big);  // and the sum at 2^127 - 1 steps (2^63 as a double)
   EXPECT_EQ(film.sum(depth, 1, 0, 0), 2.0 * limit);
+  EXPECT_EQ(film.state(1).layers[1].sums[1], (FilmSum(1) << 126) - 1 + (FilmSum(1) << 126));
   film.add(depth, 1, 0, &nan);  // adds nothing
   EXPECT_EQ(film.sum(depth, 1, 0, 0), 2.0 * limit);
 }
