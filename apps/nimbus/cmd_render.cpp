@@ -280,7 +280,8 @@ int run_render(RenderArgs args) {
   if (args.frame) result.metadata.emplace_back("nimbus/frame", std::to_string(*args.frame));
 
   if (result.nonfinite_samples > 0)
-    fmt::print(stderr, "nimbus: warning: {} non-finite samples were dropped\n", result.nonfinite_samples);
+    fmt::print(stderr, "nimbus: warning: {} non-finite or out-of-range samples were dropped\n",
+               result.nonfinite_samples);
   const char* signal = g_signal.load() == SIGTERM ? "SIGTERM" : "SIGINT";
   if (result.partial && result.spp == 0) {
     fmt::print(stderr, "nimbus: interrupted ({}) before the first pass ended: nothing written\n", signal);

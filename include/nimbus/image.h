@@ -35,14 +35,22 @@ struct Image {  // linear RGB, row-major, row 0 = top, 3 floats per pixel
   const float* pixel(int x, int y) const { return &rgb[(size_t(y) * width + x) * 3]; }
 };
 
-// A render's exact accumulation state: per film layer the double sums of its samples (`channels` per
-// pixel, row-major), and each pixel's sample count. Written beside the image in the EXR (UINT channels
-// nimbus_resume_*) so that `render --resume` continues it bit for bit (docs/cli.md).
+// A film sum: a signed 128-bit fixed-point number, its value sum * 2^-fraction_bits. Every sample enters
+// the sum rounded once to that grid (src/render/film.h), so sums add exactly: associatively, in any order.
+__extension__ typedef __int128 FilmSum;
+// A sample enters a film sum within +-2^kFilmSampleBits grid steps; a sum saturates at +-(2^127 - 1).
+inline constexpr int kFilmSampleBits = 126;
+
+// A render's exact accumulation state: per film layer the fixed-point sums of its samples (`channels` per
+// pixel, row-major, on a grid of 2^-fraction_bits), and each pixel's sample count. Written beside the
+// image in the EXR (UINT channels nimbus_resume_*) so that `render --resume` continues it and `nimbus
+// merge` adds sample ranges bit for bit (docs/cli.md).
 struct FilmState {
   struct Layer {
     std::string name;
     int channels = 0;
-    std::vector<double> sums;
+    int fraction_bits = 0;
+    std::vector<FilmSum> sums;
   };
   int width = 0, height = 0;
   int spp = 0;  // samples per pixel taken

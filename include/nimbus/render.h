@@ -84,7 +84,7 @@ struct RenderResult {
   FilmState state;
   bool partial = false;           // cancelled before the requested spp: the image of the last whole pass
   bool time_limited = false;      // stopped by RenderOptions::time_limit before the requested spp
-  int64_t nonfinite_samples = 0;  // NaN/inf samples found and dropped by the film (in this run)
+  int64_t nonfinite_samples = 0;  // NaN/inf (or beyond 4.6e18: render/film.h) samples dropped (this run)
   double seconds = 0.0;
   std::string integrator;
   int spp = 0;                  // samples per pixel in the image (adaptive: the most any pixel took)

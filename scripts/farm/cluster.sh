@@ -59,6 +59,9 @@ SelectTypeParameters=CR_Core
 JobAcctGatherType=jobacct_gather/none
 AccountingStorageType=accounting_storage/none
 ReturnToService=2
+# A batch job that exits 75 (EX_TEMPFAIL, a transient failure) is put back in the queue by Slurm itself
+# when it may be requeued (JobRequeue=1, the default, or sbatch --requeue): farm_test.sh section 4.
+RequeueExit=75
 SlurmdTimeout=30
 InactiveLimit=0
 KillWait=5

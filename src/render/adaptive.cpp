@@ -25,11 +25,10 @@ PixelStats pixel_stats(const Film& film, int layer) {
       const double n = film.samples(x, y);
       if (n < 1) continue;
       const size_t i = size_t(y) * W + x;
-      const double* a = film.sums(layer, x, y);
-      const double* rgb = film.sums(0, x, y);
-      const double sum = luminance(Rgb(rgb[0], rgb[1], rgb[2])), sum2 = a[0];
+      const Rgb rgb(film.sum(0, x, y, 0), film.sum(0, x, y, 1), film.sum(0, x, y, 2));
+      const double sum = luminance(rgb), sum2 = film.sum(layer, x, y, 0);
       p.mean[i] = sum / n;
-      p.cost[i] += a[1] / n;
+      p.cost[i] += film.sum(layer, x, y, 1) / n;
       if (n >= 2) p.var[i] = std::max(0.0, (sum2 - sum * sum / n) / (n - 1));
     }
   return p;

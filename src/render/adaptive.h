@@ -30,6 +30,10 @@ struct AdaptivePlan {
 // same on any machine and thread count).
 inline constexpr const char* kAdaptiveLayer = "adaptive";
 inline constexpr int kAdaptiveChannels = 2;
+// Its grid (render/film.h): squared luminances span more than colours do, so a coarser grid than the
+// colours' 2^-64 holds them from 3.6e-15 (a luminance of 6e-8) up to 2^78 (a luminance of 5.5e11) per
+// sample; a sample beyond is saturated, which only lowers its pixel's variance estimate.
+inline constexpr int kAdaptiveFractionBits = 48;
 // Draws a sample costs besides its own (camera ray, film): keeps a pixel of draw-free samples finite.
 inline constexpr double kSampleOverheadDraws = 8.0;
 

@@ -13,10 +13,12 @@ Film::Film(int width, int height) : width_(width), height_(height) {
   add_layer("rgb", 3);
 }
 
-int Film::add_layer(const std::string& name, int channels) {
+int Film::add_layer(const std::string& name, int channels, int fraction_bits) {
   if (layer_index(name) >= 0) throw Error("film layer '" + name + "' exists already");
   if (channels < 1) throw Error("film layer '" + name + "' needs at least one channel");
-  layers_.push_back({name, channels, std::vector<double>(size_t(channels) * count_.size(), 0.0)});
+  if (fraction_bits < 0 || fraction_bits > 120) throw Error("film layer '" + name + "': bad grid");
+  layers_.push_back({name, channels, fraction_bits, std::ldexp(1.0, fraction_bits),
+                     std::vector<FilmSum>(size_t(channels) * count_.size(), 0)});
   return int(layers_.size()) - 1;
 }
 
@@ -33,7 +35,7 @@ std::vector<float> Film::resolve_layer(int layer) const {
     if (count_[i] == 0) continue;
     for (int c = 0; c < l.channels; ++c) {
       const size_t k = size_t(l.channels) * i + size_t(c);
-      out[k] = float(l.sum[k] / count_[i]);
+      out[k] = float(double(l.sum[k]) / l.scale / count_[i]);
     }
   }
   return out;
@@ -44,7 +46,7 @@ FilmState Film::state(int spp) const {
   st.width = width_;
   st.height = height_;
   st.spp = spp;
-  for (const Layer& l : layers_) st.layers.push_back({l.name, l.channels, l.sum});
+  for (const Layer& l : layers_) st.layers.push_back({l.name, l.channels, l.fraction_bits, l.sum});
   st.counts = count_;
   return st;
 }
@@ -59,6 +61,10 @@ void Film::restore(const FilmState& st) {
                                  [&](const FilmState::Layer& s) { return s.name == l.name; });
     if (it == st.layers.end() || it->channels != l.channels || it->sums.size() != l.sum.size())
       throw Error(fmt::format("resume data: no film layer '{}' of {} channels", l.name, l.channels));
+    if (it->fraction_bits != l.fraction_bits)
+      throw Error(
+          fmt::format("resume data: film layer '{}' is summed on a grid of 2^-{}, the render's of 2^-{}",
+                      l.name, it->fraction_bits, l.fraction_bits));
   }
   if (st.layers.size() != layers_.size())
     throw Error(

@@ -63,7 +63,7 @@ FilmLayers::FilmLayers(Film& film, const FilmSettings& settings, bool has_enviro
 
 bool FilmLayers::add(Film& film, int x, int y, const Rgb& L, const CameraSample& s) const {
   // The beauty: on an opaque film exactly Li (the images of a film without layers are unchanged).
-  if (!film.add_sample(x, y, transparent_ ? L - s.background : L)) return false;
+  if (!film.add_sample(x, y, beauty(L, s))) return false;
   const double alpha = sample_alpha(s, background_opaque_);
   if (std::isfinite(alpha)) film.add(alpha_, x, y, &alpha);
   if (depth_ >= 0 && std::isfinite(s.depth)) {

@@ -30,6 +30,8 @@ class FilmLayers {
 
   // Whether any layer needs the sample's depth or albedo.
   bool depth_wanted() const { return depth_ >= 0 || albedo_ >= 0; }
+  // What the beauty takes of a sample: L, less the background on a transparent film.
+  Rgb beauty(const Rgb& L, const CameraSample& s) const { return transparent_ ? L - s.background : L; }
   // One camera sample of pixel (x, y): its radiance L (less the background on a transparent film) and
   // layers. A non-finite L is dropped from every layer (counted as a sample): returns false.
   bool add(Film& film, int x, int y, const Rgb& L, const CameraSample& s) const;

@@ -1,6 +1,7 @@
 // Merging renders of one frame (nimbus/merge.h). Each input is a data window (its crop) and a sample
-// range [start, start + spp); the film states' double sums of every pixel are added in the order of the
-// ranges' starts, so a pixel covered by one input keeps its sums exactly (tiles assemble bit for bit).
+// range [start, start + spp); the film states' fixed-point sums of every pixel are added. Integer sums
+// add exactly, so tiles assemble and sample ranges add up to the render of all their samples bit for bit
+// (render/film.h).
 // The cells between the windows' edges are each covered by one set of inputs: the coverage is checked
 // cell by cell, not pixel by pixel.
 #include "nimbus/merge.h"
@@ -102,7 +103,7 @@ void check_compatible(const Input& first, const Input& in) {
   auto layers = [](const FilmState& s) {
     std::string out;
     for (const FilmState::Layer& l : s.layers)
-      out += fmt::format("{}{}:{}", out.empty() ? "" : ",", l.name, l.channels);
+      out += fmt::format("{}{}:{}/2^-{}", out.empty() ? "" : ",", l.name, l.channels, l.fraction_bits);
     return out;
   };
   if (layers(first.state) != layers(in.state))
@@ -213,7 +214,7 @@ MergeResult merge_renders(const std::vector<std::filesystem::path>& files) {
          std::max(w.y1, in.y0 + in.image.height)};
   const auto [start, end] = check_coverage(inputs, w);
 
-  // The sums, pixel by pixel in the order of the ranges' starts (a pixel's first input is copied exactly).
+  // The sums, pixel by pixel (exact: any order gives the same).
   const int W = w.x1 - w.x0, H = w.y1 - w.y0;
   Film film(W, H);
   const FilmLayers layers(film, film_settings(inputs[0]), false);
@@ -225,23 +226,28 @@ MergeResult merge_renders(const std::vector<std::filesystem::path>& files) {
     for (const FilmState::Layer& out : st.layers) {
       const auto it = std::find_if(in.state.layers.begin(), in.state.layers.end(),
                                    [&](const FilmState::Layer& l) { return l.name == out.name; });
-      if (it == in.state.layers.end() || it->channels != out.channels)
-        throw Error(fmt::format("{}: its film state has no layer '{}' of {} channels (the scene's film)",
-                                in.file, out.name, out.channels));
+      if (it == in.state.layers.end() || it->channels != out.channels ||
+          it->fraction_bits != out.fraction_bits)
+        throw Error(
+            fmt::format("{}: its film state has no layer '{}' of {} channels on a grid of 2^-{} (the "
+                        "scene's film)",
+                        in.file, out.name, out.channels, out.fraction_bits));
       from.push_back(&*it);
     }
     for (int y = 0; y < in.image.height; ++y)
       for (int x = 0; x < in.image.width; ++x) {
         const size_t src = size_t(y) * size_t(in.image.width) + size_t(x);
         const size_t dst = size_t(in.y0 + y - w.y0) * size_t(W) + size_t(in.x0 + x - w.x0);
-        const bool first = st.counts[dst] == 0;  // copied, not added to 0 (which would turn -0 into +0)
         for (size_t l = 0; l < st.layers.size(); ++l) {
           const size_t k = size_t(st.layers[l].channels);
-          double* out = &st.layers[l].sums[k * dst];
-          const double* add = &from[l]->sums[k * src];
-          for (size_t c = 0; c < k; ++c) out[c] = first ? add[c] : out[c] + add[c];
+          FilmSum* out = &st.layers[l].sums[k * dst];
+          const FilmSum* add = &from[l]->sums[k * src];
+          for (size_t c = 0; c < k; ++c)  // sums that would leave 128 bits are refused
+            if (__builtin_add_overflow(out[c], add[c], &out[c]))
+              throw Error(fmt::format("{}: the film sums overflow at pixel ({}, {})", in.file, x, y));
         }
-        st.counts[dst] += in.state.counts[src];
+        if (__builtin_add_overflow(st.counts[dst], in.state.counts[src], &st.counts[dst]))
+          throw Error(fmt::format("{}: the sample counts overflow at pixel ({}, {})", in.file, x, y));
       }
   }
   film.restore(st);

@@ -1,9 +1,10 @@
 // The driver: resolves the render's settings, builds the scene context and the integrator through the
 // registry, makes the camera rays and adds their radiance to the film, in passes over the whole image
 // (1, 2, 4, ... spp), each tile by tile over oneTBB. Every sample is seeded from (seed, pixel, sample
-// index) and a pixel's samples are added in order into double sums, so the image is bit-identical for
-// any thread count and for any split into passes: a render stopped (cancel, time budget) and resumed
-// from its film state equals the render made in one go. Progress and cancellation go through callbacks.
+// index) and added into the film's exact fixed-point sums (render/film.h), so the image is bit-identical
+// for any thread count and for any split into passes or sample ranges: a render stopped (cancel, time
+// budget) and resumed from its film state, or merged from ranges, equals the render made in one go.
+// Progress and cancellation go through callbacks.
 #include "nimbus/render.h"
 
 #include <fmt/format.h>
@@ -133,15 +134,13 @@ int64_t render_pixel(const Integrator& integrator, const PinholeCamera& camera,
     if (to.time_film) sample.timed = &timed;
     const uint64_t rng_start = rng.state();
     const Rgb L = integrator.Li(camera.generate_ray(x + jx, y + jy), rng, &sample);
-    const double* rgb = to.film.sums(0, x - to.x0, y - to.y0);
-    const double before = to.adaptive_layer >= 0 ? luminance(Rgb(rgb[0], rgb[1], rgb[2])) : 0.0;
     if (!to.layers.add(to.film, x - to.x0, y - to.y0, L, sample)) {
       ++bad;
       continue;  // a dropped sample adds nothing to the deep pixel (or the time bins) either
     }
     if (to.time_film) to.time_film->add(x - to.x0, y - to.y0, timed);
     if (to.adaptive_layer >= 0) {  // the luminance the film took (less a transparent film's background)
-      const double lum = luminance(Rgb(rgb[0], rgb[1], rgb[2])) - before;
+      const double lum = luminance(to.layers.beauty(L, sample));
       const double a[kAdaptiveChannels] = {lum * lum, double(rng.draws_since(rng_start))};
       to.film.add(to.adaptive_layer, x - to.x0, y - to.y0, a);
     }
@@ -307,8 +306,9 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
                                     [](const FilmState::Layer& l) { return l.name == kAdaptiveLayer; });
   if (adaptive && options.resume && !resumed_adaptive)
     throw Error("resume: adaptive sampling continues only a render made with a noise target");
-  const int adaptive_layer =
-      adaptive || resumed_adaptive ? film.add_layer(kAdaptiveLayer, kAdaptiveChannels) : -1;
+  const int adaptive_layer = adaptive || resumed_adaptive
+                                 ? film.add_layer(kAdaptiveLayer, kAdaptiveChannels, kAdaptiveFractionBits)
+                                 : -1;
   int done = 0;
   if (options.resume) {
     film.restore(*options.resume);
