@@ -214,7 +214,7 @@ TEST(EnvMapParse, BadInputsNameTheFileAndField) {
   }
   auto scene = [](const nlohmann::json& light) {
     nlohmann::json doc = nlohmann::json::parse("{" + test::camera_json() + R"(, "media": []})");
-    doc["lights"] = {light};
+    doc["lights"] = nlohmann::json::array({light});  // not {light}: clang takes that for a copy
     return doc;
   };
   struct Case {
