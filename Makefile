@@ -10,9 +10,9 @@ BUILD ?= build
 JOBS ?= $(shell nproc)
 CMAKE_FLAGS ?=
 FUZZ_SECONDS ?= 600
-# Left out of the sanitizer run (docs/reliability.md): minutes under ASan, and their code paths are
-# the ones the other fast tests already take there.
-ASAN_SKIP ?= ^Stress\.ExtremeScenesHaveNoNonFiniteSamples$$|^Determinism\.EveryIntegratorIsBitIdenticalForAnyThreadCount$$
+# Left out of the sanitizer run (docs/reliability.md): 30 s to 2 min each under ASan, and their code
+# paths are the ones the other fast tests (Mfs.* among them) already take there.
+ASAN_SKIP ?= ^Stress\.ExtremeScenesHaveNoNonFiniteSamples$$|^Determinism\.EveryIntegratorIsBitIdenticalForAnyThreadCount$$|^Mfs\.(WhiteFurnaceWithAllOrders|FilteredLookupsOfTheScatterGrid|GrowingStepsMatchFixedSteps|BitIdenticalForAnyThreadCount|MoreWideScattersAddLight|IsotropicMediumMatchesPathTracerOrderByOrder|BeamGridReproducesTheStraightBeamWithoutDeflection)$$
 
 .PHONY: all deps configure build python demo test test-fast asan bench clean fuzz-build fuzz-smoke fuzz fuzz-seeds farm-test
 
