@@ -74,7 +74,41 @@ py::dict layer_arrays(const Image& img) {
   return out;
 }
 
-py::dict result_dict(const RenderResult& r) {
+// A transient render's bins (scene film.time_bins): "bins" N x H x W x 3 in time order, "under" and
+// "over" H x W x 3 (path lengths before t0 and from t1 on), "edges" the N + 1 bin edges; together they
+// sum to the steady image's RGB (docs/transient.md).
+py::dict time_bins_dict(const Image& t, const TimeBins& tb) {
+  const size_t n = size_t(t.width) * t.height, N = size_t(tb.count);
+  std::vector<float> bins(N * n * 3, 0.0f), under(n * 3, 0.0f), over(n * 3, 0.0f);
+  for (const ImageChannel& c : t.channels) {
+    const std::string layer = layer_of(c.name);
+    const char ch = c.name.back();
+    const int ci = ch == 'R' ? 0 : ch == 'G' ? 1 : ch == 'B' ? 2 : -1;
+    if (ci < 0 || c.name.size() != layer.size() + 2) continue;
+    float* dst = nullptr;
+    if (layer == "time_under") {
+      dst = under.data();
+    } else if (layer == "time_over") {
+      dst = over.data();
+    } else if (layer.size() == 8 && layer.rfind("time", 0) == 0 &&
+               layer.find_first_not_of("0123456789", 4) == std::string::npos) {
+      const size_t k = std::stoul(layer.substr(4));
+      if (k < N) dst = &bins[k * n * 3];
+    }
+    if (!dst) continue;
+    for (size_t i = 0; i < n; ++i) dst[i * 3 + ci] = c.data[i];
+  }
+  std::vector<double> edges(N + 1);
+  for (size_t k = 0; k <= N; ++k) edges[k] = tb.t0 + (tb.t1 - tb.t0) * double(k) / double(N);
+  py::dict d;
+  d["bins"] = float_array(bins, {py::ssize_t(N), t.height, t.width, 3});
+  d["under"] = float_array(under, {t.height, t.width, 3});
+  d["over"] = float_array(over, {t.height, t.width, 3});
+  d["edges"] = py::array_t<double>(py::ssize_t(edges.size()), edges.data());
+  return d;
+}
+
+py::dict result_dict(const RenderResult& r, const Scene& scene) {
   py::dict d;
   d["rgba"] = rgba_array(r.image);
   d["layers"] = layer_arrays(r.image);
@@ -93,6 +127,8 @@ py::dict result_dict(const RenderResult& r) {
   py::dict meta;
   for (const auto& [k, v] : r.metadata) meta[py::str(k)] = v;
   d["metadata"] = meta;
+  if (scene.film.time_bins && r.transient.width > 0)
+    d["time_bins"] = time_bins_dict(r.transient, *scene.film.time_bins);
   return d;
 }
 
@@ -173,7 +209,7 @@ py::dict render_py(const py::object& scene_obj, std::optional<int> spp, int thre
   if (raised) throw std::move(*raised);
   if (run.error) std::rethrow_exception(run.error);
   if (run.result.partial) throw Cancelled();
-  return result_dict(run.result);
+  return result_dict(run.result, *scene);
 }
 
 }  // namespace
@@ -203,7 +239,10 @@ Returns a dict: 'rgba' float32 H x W x 4 (linear, premultiplied alpha, row 0 the
 {name: float32 H x W (depth [world units], samples) or H x W x 3}, and the resolved settings:
 'width', 'height', 'integrator', 'spp' (reached), 'spp_requested', 'seed', 'seconds' (wall time),
 'time_limited', 'nonfinite_samples', 'spp_mean', 'noise_estimate' (adaptive sampling), 'settings' (the integrator block as rendered, auto choices
-resolved), 'metadata' (what an EXR header would carry).)");
+resolved), 'metadata' (what an EXR header would carry). A transient render (the scene's
+film.time_bins, pathtrace only) adds 'time_bins': {'bins' float32 N x H x W x 3 in time order, 'under' and
+'over' H x W x 3 (path lengths before t0, from t1 on), 'edges' the N + 1 edges}; bins, under and over sum
+to the RGB (docs/transient.md).)");
   m.def("integrator_names", &integrator_names, "Names of the integrators.");
   m.def("layer_names", &film_layer_names, "Names of the compositing layers a render can keep.");
 }

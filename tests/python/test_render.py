@@ -222,5 +222,25 @@ class ProgressAndInterrupt(unittest.TestCase):
         self.assertGreaterEqual(r["spp"], 1)
 
 
+class TransientRender(unittest.TestCase):
+    def test_time_bins_sum_to_the_image(self):
+        doc = small_scene("pathtrace", spp=4)
+        doc["film"] = {"time_bins": [3.0, 9.0, 6]}
+        r = nimbus.render(doc, threads=2)
+        plain = nimbus.render(small_scene("pathtrace", spp=4), threads=2)
+        self.assertTrue(np.array_equal(r["rgba"], plain["rgba"]))  # the steady image is unchanged
+        t = r["time_bins"]
+        self.assertEqual(t["bins"].shape, (6, 16, 24, 3))
+        self.assertEqual((t["under"].shape, t["over"].shape), ((16, 24, 3), (16, 24, 3)))
+        self.assertTrue(np.allclose(t["edges"], np.linspace(3.0, 9.0, 7)))
+        total = t["bins"].astype(np.float64).sum(axis=0) + t["under"] + t["over"]
+        rgb = r["rgba"][..., :3].astype(np.float64)
+        self.assertTrue(np.allclose(total, rgb, rtol=1e-5, atol=1e-7), float(np.abs(total - rgb).max()))
+        self.assertGreater(float(t["bins"].sum()), 0.1 * float(rgb.sum()))  # the bins hold the light
+        again = nimbus.render(doc, threads=1)["time_bins"]
+        self.assertTrue(np.array_equal(again["bins"], t["bins"]))
+        self.assertNotIn("time_bins", plain)
+
+
 if __name__ == "__main__":
     unittest.main()
