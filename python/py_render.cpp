@@ -90,7 +90,7 @@ py::dict time_bins_dict(const Image& t, const TimeBins& tb) {
       dst = under.data();
     } else if (layer == "time_over") {
       dst = over.data();
-    } else if (layer.size() == 8 && layer.rfind("time", 0) == 0 &&
+    } else if (layer.size() > 4 && layer.rfind("time", 0) == 0 &&
                layer.find_first_not_of("0123456789", 4) == std::string::npos) {
       const size_t k = std::stoul(layer.substr(4));
       if (k < N) dst = &bins[k * n * 3];

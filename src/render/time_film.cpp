@@ -2,7 +2,9 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
+#include <string>
 
 #include "nimbus/error.h"
 
@@ -41,10 +43,16 @@ void TimeFilm::add(int x, int y, const std::vector<TimedContribution>& parts) {
   }
 }
 
+namespace {
+// Bin numbers are zero-padded to 4 digits, or to as many as the last bin needs (over 10000 bins), so that
+// the layers sort in time order by name.
+int time_layer_digits(int count) { return std::max(4, int(std::to_string(std::max(0, count - 1)).size())); }
+}  // namespace
+
 std::string TimeFilm::layer_name(int b) const {
   if (b == 0) return "time_under";
   if (b == slots_ - 1) return "time_over";
-  return fmt::format("time{:04d}", b - 1);
+  return fmt::format("time{:0{}d}", b - 1, time_layer_digits(bins_.count));
 }
 
 std::vector<ImageChannel> TimeFilm::resolve(const Film& film) const {
@@ -65,11 +73,10 @@ std::vector<ImageChannel> TimeFilm::resolve(const Film& film) const {
 }
 
 ImageMetadata TimeFilm::metadata() const {
-  return {
-      {"nimbus/time_bins", fmt::format("{},{},{}", bins_.t0, bins_.t1, bins_.count)},
-      {"nimbus/time_bin_width", fmt::format("{}", (bins_.t1 - bins_.t0) / bins_.count)},
-      {"nimbus/time_layers", fmt::format("time_under (s < {}), time0000 .. time{:04d}, time_over (s >= {})",
-                                         bins_.t0, bins_.count - 1, bins_.t1)}};
+  return {{"nimbus/time_bins", fmt::format("{},{},{}", bins_.t0, bins_.t1, bins_.count)},
+          {"nimbus/time_bin_width", fmt::format("{}", (bins_.t1 - bins_.t0) / bins_.count)},
+          {"nimbus/time_layers", fmt::format("time_under (s < {}), {} .. {}, time_over (s >= {})", bins_.t0,
+                                             layer_name(1), layer_name(slots_ - 2), bins_.t1)}};
 }
 
 }  // namespace nimbus
