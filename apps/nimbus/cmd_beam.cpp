@@ -22,7 +22,6 @@
 #include <vector>
 
 #include "commands.h"
-#include "io/atomic_file.h"
 #include "nimbus/error.h"
 #include "transport/beam_table.h"
 #include "transport/phase_spec.h"
@@ -100,17 +99,7 @@ int run_beam(const BeamArgs& a) {
     text += fmt::format("{},{:.9g},{},{:.9g},{:.9g},{:.9g},{:.9g},{},{}\n", r.model, r.depth, r.quantity,
                         r.lo, r.hi, r.value, r.stderr_, bin_unit, value_unit);
   }
-  if (a.out.empty() || a.out == "-") {
-    std::fwrite(text.data(), 1, text.size(), stdout);
-  } else {
-    try {
-      atomic_write_bytes(a.out, text);
-    } catch (const Error&) {
-      fmt::print(stderr, "nimbus: error: cannot write {}\n", a.out);
-      return kExitFailure;
-    }
-  }
-  return kExitOk;
+  return write_text(a.out, text) ? kExitOk : kExitFailure;
 }
 
 }  // namespace

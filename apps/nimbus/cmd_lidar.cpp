@@ -21,7 +21,6 @@
 
 #include "commands.h"
 #include "core/math.h"
-#include "io/atomic_file.h"
 #include "nimbus/error.h"
 #include "transport/lidar.h"
 #include "transport/phase_spec.h"
@@ -128,17 +127,7 @@ int run_lidar(const LidarArgs& a) {
       for (size_t i = 0; i + 1 < e.size(); ++i) row(m, e[i], e[i + 1], v[i], 0.0);
     }
   }
-  if (a.out.empty() || a.out == "-") {
-    std::fwrite(text.data(), 1, text.size(), stdout);
-    return kExitOk;
-  }
-  try {
-    atomic_write_bytes(a.out, text);
-  } catch (const Error&) {
-    fmt::print(stderr, "nimbus: error: cannot write {}\n", a.out);
-    return kExitFailure;
-  }
-  return kExitOk;
+  return write_text(a.out, text) ? kExitOk : kExitFailure;
 }
 
 }  // namespace

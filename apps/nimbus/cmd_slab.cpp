@@ -21,7 +21,6 @@
 
 #include "commands.h"
 #include "core/math.h"
-#include "io/atomic_file.h"
 #include "nimbus/error.h"
 #include "transport/phase_spec.h"
 #include "transport/photon_mc.h"
@@ -43,21 +42,6 @@ struct SlabArgs {
   std::string time_edges, time_csv;
   bool time_given = false;
 };
-
-// Writes `text` to `path` (or stdout for "" and "-"); false when the file cannot be written.
-bool write_text(const std::string& path, const std::string& text) {
-  if (path.empty() || path == "-") {
-    std::fwrite(text.data(), 1, text.size(), stdout);
-    return true;
-  }
-  try {
-    atomic_write_bytes(path, text);
-  } catch (const Error&) {
-    fmt::print(stderr, "nimbus: error: cannot write {}\n", path);
-    return false;
-  }
-  return true;
-}
 
 // The time-resolved exits as CSV (see the top of this file).
 std::string time_csv(const std::vector<double>& edges, const PhotonMcResult& r) {

@@ -27,6 +27,10 @@ void add_lidar_command(CLI::App& app, Action& action);
 // the work, so that a long run never ends in a path it cannot write.
 void check_output_path(const std::string& path, const std::string& option);
 
+// Writes `text` to `path` (or stdout for "" and "-"), atomically; false, with an error on stderr, when the
+// file cannot be written. The CSV output of beam, slab and lidar.
+bool write_text(const std::string& path, const std::string& text);
+
 // Exit codes.
 inline constexpr int kExitOk = 0;
 inline constexpr int kExitFailure = 1;   // the run itself failed (I/O error writing, cancelled)

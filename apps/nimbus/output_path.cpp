@@ -1,9 +1,11 @@
-// Output paths, checked before any work is done (commands.h).
+// Output paths, checked before any work is done, and the CSV writer (commands.h).
 #include <fmt/format.h>
 
+#include <cstdio>
 #include <filesystem>
 
 #include "commands.h"
+#include "io/atomic_file.h"
 #include "nimbus/error.h"
 
 namespace nimbus::cli {
@@ -18,6 +20,20 @@ void check_output_path(const std::string& path, const std::string& option) {
   const fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
   if (!fs::is_directory(dir, ec))
     throw Error(fmt::format("{}: {}: the folder '{}' does not exist", option, path, dir.string()));
+}
+
+bool write_text(const std::string& path, const std::string& text) {
+  if (path.empty() || path == "-") {
+    std::fwrite(text.data(), 1, text.size(), stdout);
+    return true;
+  }
+  try {
+    atomic_write_bytes(path, text);
+  } catch (const Error&) {
+    fmt::print(stderr, "nimbus: error: cannot write {}\n", path);
+    return false;
+  }
+  return true;
 }
 
 }  // namespace nimbus::cli
