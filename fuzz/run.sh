@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Runs the libFuzzer targets built in build-san/ (make fuzz-build) for SECONDS each, one after the
-# other: make fuzz-smoke runs it with 60 s, make fuzz FUZZ_SECONDS=N with N. New inputs go to
+# Runs the libFuzzer targets built in build-san/ (make fuzz-build) for SECONDS each, FUZZ_JOBS of them at
+# a time (default: the number of cores; each target is one libFuzzer worker): make fuzz-smoke runs it
+# with 60 s, make fuzz FUZZ_SECONDS=N with N. New inputs go to
 # build-san/corpus/<target>/ (the committed seeds in fuzz/corpus/<target>/ are only read); a crash,
 # leak, timeout or out-of-memory input is written to build-san/artifacts/<target>/ and fails the run.
 # Usage: [FUZZ_SEED=N] fuzz/run.sh SECONDS [TARGET...]   (targets: scene vdb cli mesh; default all)
@@ -16,11 +17,18 @@ BUILD_FUZZ=${BUILD_FUZZ:-build-san}
 export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1}
 export LSAN_OPTIONS=${LSAN_OPTIONS:-suppressions=$PWD/fuzz/lsan.supp}
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
+jobs=${FUZZ_JOBS:-$(nproc)}
 for t in "${targets[@]}"; do
   bin="$BUILD_FUZZ/bin/${t}_fuzz"
   [ -x "$bin" ] || { echo "fuzz/run.sh: $bin not built (make fuzz-build)" >&2; exit 1; }
-  asan=$ASAN_OPTIONS
-  extra=()
+done
+
+# Fuzzes one target; its summary lines go to stderr prefixed with the target's name, its whole log to
+# $BUILD_FUZZ/<target>.log. Returns non-zero on a finding.
+fuzz_one() {
+  local t=$1 bin="$BUILD_FUZZ/bin/${1}_fuzz"
+  local asan=$ASAN_OPTIONS max_len timeout status
+  local extra=()
   case $t in
     # The uncompressed NanoVDB seed is ~310 KB. vdb_fuzz replaces operator new (see the file), so
     # memory from a library's operator new may come back through its free(): not a finding.
@@ -36,17 +44,23 @@ for t in "${targets[@]}"; do
          extra=(-fork=1 -ignore_crashes=1 -ignore_timeouts=1 -ignore_ooms=1 -detect_leaks=0) ;;
     *) max_len=4096; timeout=10 ;;  # scene, cli, mesh (OBJ text)
   esac
-  dict=()
+  local dict=()
   [ -f "fuzz/$t.dict" ] && dict=(-dict="fuzz/$t.dict")
   mkdir -p "$BUILD_FUZZ/corpus/$t" "$BUILD_FUZZ/artifacts/$t"
   echo "fuzz/run.sh: $t for ${seconds}s" >&2
   # One worker; -timeout: one input over 10 s (vdb: 30 s) is a hang; -rss_limit_mb: memory over
   # 2 GiB is a bug (a malloc above it, too).
-  ASAN_OPTIONS=$asan "$bin" "$BUILD_FUZZ/corpus/$t" "fuzz/corpus/$t" "${dict[@]}" "${extra[@]}" -max_total_time="$seconds" -seed="${FUZZ_SEED:-0}" \
+  # The fuzzer's own exit status decides (PIPESTATUS[0], read in the branch: a `|| true` after the
+  # pipeline would replace it with true's).
+  if ASAN_OPTIONS=$asan "$bin" "$BUILD_FUZZ/corpus/$t" "fuzz/corpus/$t" "${dict[@]}" "${extra[@]}" -max_total_time="$seconds" -seed="${FUZZ_SEED:-0}" \
     -timeout="$timeout" -rss_limit_mb=2048 -max_len="$max_len" -print_final_stats=1 \
     -artifact_prefix="$BUILD_FUZZ/artifacts/$t/" 2>&1 | tee "$BUILD_FUZZ/$t.log" | \
-    grep -E '^(#[0-9]+.*(INITED|DONE|pulse))|^#[0-9]+: cov|stat::|ERROR|SUMMARY|Test unit written|^==|^INFO: (fuzzed|exiting)|^Done' >&2 || true
-  status=${PIPESTATUS[0]}
+    grep -E '^(#[0-9]+.*(INITED|DONE|pulse))|^#[0-9]+: cov|stat::|ERROR|SUMMARY|Test unit written|^==|^INFO: (fuzzed|exiting)|^Done' | \
+    sed "s/^/[$t] /" >&2; then
+    status=0
+  else
+    status=${PIPESTATUS[0]}
+  fi
   if [ ${#extra[@]} -gt 0 ]; then  # fork mode: the saved inputs decide
     status=0
     grep -q '^INFO: fuzzed for' "$BUILD_FUZZ/$t.log" || status=1
@@ -54,6 +68,22 @@ for t in "${targets[@]}"; do
   fi
   if [ "$status" -ne 0 ]; then
     echo "fuzz/run.sh: $t FAILED (exit $status); see $BUILD_FUZZ/$t.log and $BUILD_FUZZ/artifacts/$t/" >&2
-    exit 1
+    return 1
   fi
+}
+
+# At most $jobs targets at once; every target runs to its end, and the run fails if any of them found
+# something.
+failed=0
+pids=()
+names=()
+for t in "${targets[@]}"; do
+  while [ "$(jobs -rp | wc -l)" -ge "$jobs" ]; do sleep 1; done
+  fuzz_one "$t" &
+  pids+=($!)
+  names+=("$t")
 done
+for i in "${!pids[@]}"; do
+  wait "${pids[$i]}" || { failed=1; echo "fuzz/run.sh: ${names[$i]} failed" >&2; }
+done
+exit $failed
