@@ -201,10 +201,10 @@ Rgb PathTracer::Li(const Ray& ray, Rng& rng, CameraSample* sample) const {
     // The free flight ends at the first surface, if any.
     SurfaceHit hit;
     const bool to_surface = ctx_.surfaces.intersect(o, d, std::numeric_limits<double>::infinity(), &hit);
-    // Delta tracking to the next real scattering event.
+    // Delta tracking to the next real scattering event (analytic media: against their exact extinction).
     int scatter_medium = -1;
     Vec3 scatter_p;
-    const bool escaped = track(ctx_.majorants, o, d, hit.t, rng, [&](const Vec3& p, double maj) {
+    const bool escaped = track(ctx_, o, d, hit.t, rng, [&](const Vec3& p, double maj) {
       ctx_.media.eval(p, &mp);
       // Emission at every tentative collision, j / majorant: an unbiased estimate of int T j dt.
       if (ctx_.media.emits()) clock.add(L, beta * mp.emission / maj, clock.from(o, p));
