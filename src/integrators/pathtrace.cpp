@@ -184,7 +184,7 @@ bool PathTracer::collide(const MediumPoint& mp, double maj, Rgb& beta, Rng& rng,
 // Russian roulette on the largest channel m of the throughput, from the fourth event on, once m has
 // fallen below 0.1 (as Tungsten): the path survives with probability m, its throughput rescaled to 1.
 // (Rouletting every event with probability min(1, m) killed 1 - albedo of the paths at each scatter,
-// an analogue absorption that cost 8-16 % more variance per sample on the suite's spheres for 3-7 %
+// an analogue absorption that cost 8-16 % more variance per sample on the suite's spheres for 3-12 %
 // less time: docs/benchmarks.md.)
 bool survives_roulette(int events, Rgb& beta, Rng& rng) {
   constexpr double kRouletteBelow = 0.1;
