@@ -12,6 +12,12 @@ AnalyticMedia::AnalyticMedia(const SceneMedia& media) {
     p.to_local = m.transform.inverse();
     p.sigma_t = m.sigma_s + m.sigma_a;
     p.majorant = max_component(p.sigma_t);
+    // A pure absorber alone on the ray (no scattering anywhere in it) gets twice its extinction as the
+    // majorant: against the exact one every tentative collision would end the path (an analogue
+    // absorption, and the camera ray's layers behind it, depth and holdout, lost with it); with half of
+    // them null collisions the path goes on with the ratio-tracking weight (1 - sigma_t / majorant per
+    // collision). (Several media: each piece's majorant is its exact extinction.)
+    if (max_component(m.sigma_s) <= 0.0) p.majorant *= 2.0;
     if (const auto* s = std::get_if<SphereShape>(&m.shape)) {
       p.center = s->center;
       p.radius = s->radius;
