@@ -34,7 +34,7 @@ class AnalyticMedia {
 
   // Visits the pieces of o + t d, t in (0, tmax), of constant non-zero extinction in order, calling
   // segment(t0, t1, majorant) -> bool (false stops); majorant = the largest channel of the piece's total
-  // sigma_t (the same call as MajorantGrid::traverse, with the tightest majorant).
+  // sigma_t, the tightest (twice it for a lone pure absorber: analytic_media.cpp); as MajorantGrid::traverse.
   template <typename F>
   void traverse(const Vec3& o, const Vec3& d, double tmax, F&& segment) const;
 
