@@ -3,10 +3,12 @@
 // Null-scattering delta tracking against the majorant grid; chromatic media by spectral tracking
 // (one scalar majorant for all channels, collision events chosen with channel-averaged
 // probabilities weighted by the path throughput and per-channel weights: Kutz et al. 2017's
-// history-aware spectral tracking); next-event estimation to every light
-// with ratio-tracked transmittance (a constant environment through a phase-sampled direction, an
-// environment image by MIS of a map- and a phase-sampled direction: integrators/env_light.h); exact
-// phase sampling; unbiased Russian roulette.
+// history-aware spectral tracking); next-event estimation to every light with ratio-tracked
+// transmittance (a constant environment through a phase-sampled direction, an environment image by
+// MIS of a map- and a phase-sampled direction: integrators/env_light.h); exact phase sampling;
+// unbiased Russian roulette. Where every medium is a constant-density sphere or box (no emission),
+// free flights are tracked against their exact extinction, piece by piece (grey media: no null
+// collisions), and the transmittance is taken in closed form (media/analytic_media.h).
 //
 // Options (the JSON fields of the scene's integrator block besides type, spp, seed, max_events):
 //

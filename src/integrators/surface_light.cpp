@@ -24,6 +24,8 @@ Rgb shadow_transmittance(const SceneContext& ctx, const Vec3& p, const Vec3& w, 
                          double march_step) {
   if (ctx.surfaces.occluded(p, w, tmax)) return Rgb(0.0);
   if (march_step > 0.0) return marched_transmittance(ctx.media, ctx.majorants, p, w, tmax, march_step);
+  // Constant-density shapes: the closed form exp(-sigma_t x chord), exact and free of noise.
+  if (ctx.analytic.active()) return ctx.analytic.transmittance(p, w, tmax);
   return ratio_tracking_transmittance(ctx.media, ctx.majorants, p, w, tmax, rng);
 }
 

@@ -1,5 +1,6 @@
 // The one tracking kernel (after pbrt-v4's SampleT_maj): tentative collisions distributed with the
-// majorant density, cell by cell of the majorant grid. Delta tracking (pathtrace), ratio tracking
+// majorant density, cell by cell of the majorant grid (or piece by piece of analytic media, each with its
+// exact extinction: media/analytic_media.h). Delta tracking (pathtrace), ratio tracking
 // (transmittance) and the other integrators all build on it. Debug builds check its invariants
 // (NIMBUS_DCHECK: majorants finite and non-negative, extinction in [0, majorant], weights finite and
 // non-negative); Release builds compile the checks away.
@@ -11,27 +12,27 @@
 
 #include "core/check.h"
 #include "core/rng.h"
+#include "media/analytic_media.h"
 #include "media/majorant.h"
 #include "media/media.h"
+#include "scene/context.h"
 
 namespace nimbus {
 
-// Calls on_collision(p, majorant) -> bool at tentative collisions along o + t d (d unit), t in
-// (0, tmax). Returns true when the ray reached tmax (or left the media), false when the callback
-// stopped it.
-// scale (in [0, 1]) multiplies every cell's majorant: for a density known to stay below that share
-// of the extinction (mfs's photons see a reduced extinction), fewer tentative collisions.
-template <typename F>
-bool track(const MajorantGrid& grid, const Vec3& o, const Vec3& d, double tmax, double scale, Rng& rng,
-           F&& on_collision) {
+// Tentative collisions along the segments that visit(segment) hands to segment(t0, t1, majorant) -> bool in
+// order (a majorant grid's cells, or an analytic medium's pieces): calls on_collision(p, majorant) -> bool
+// at each; scale (in [0, 1]) multiplies every majorant. Returns true when the ray reached the end, false
+// when the callback stopped it.
+template <typename Visit, typename F>
+bool track_segments(Visit&& visit, const Vec3& o, const Vec3& d, double scale, Rng& rng, F&& on_collision) {
   bool reached_end = true;
-  grid.traverse(o, d, 0.0, tmax, [&](double t0, double t1, double cell_maj) {
-    const double maj = cell_maj * scale;
+  visit([&](double t0, double t1, double segment_maj) {
+    const double maj = segment_maj * scale;
     NIMBUS_DCHECK(maj >= 0.0 && std::isfinite(maj));
     if (maj <= 0.0) return true;
     double t = t0;
     while (true) {
-      // Exponential step; memorylessness lets each cell restart at its entry.
+      // Exponential step; memorylessness lets each segment restart at its entry.
       t -= std::log1p(-rng.uniform()) / maj;
       if (t >= t1) return true;
       if (!on_collision(o + d * t, maj)) {
@@ -43,9 +44,38 @@ bool track(const MajorantGrid& grid, const Vec3& o, const Vec3& d, double tmax, 
   return reached_end;
 }
 
+// Calls on_collision(p, majorant) -> bool at tentative collisions along o + t d (d unit), t in
+// (0, tmax), cell by cell of the majorant grid. Returns true when the ray reached tmax (or left the
+// media), false when the callback stopped it.
+// scale (in [0, 1]) multiplies every cell's majorant: for a density known to stay below that share
+// of the extinction (mfs's photons see a reduced extinction), fewer tentative collisions.
+template <typename F>
+bool track(const MajorantGrid& grid, const Vec3& o, const Vec3& d, double tmax, double scale, Rng& rng,
+           F&& on_collision) {
+  return track_segments([&](auto&& segment) { grid.traverse(o, d, 0.0, tmax, segment); }, o, d, scale, rng,
+                        std::forward<F>(on_collision));
+}
+
 template <typename F>
 bool track(const MajorantGrid& grid, const Vec3& o, const Vec3& d, double tmax, Rng& rng, F&& on_collision) {
   return track(grid, o, d, tmax, 1.0, rng, std::forward<F>(on_collision));
+}
+
+// The same over the pieces of analytic media (media/analytic_media.h), each with its exact extinction
+// as the majorant: with grey media every tentative collision is a real one.
+template <typename F>
+bool track(const AnalyticMedia& media, const Vec3& o, const Vec3& d, double tmax, Rng& rng,
+           F&& on_collision) {
+  return track_segments([&](auto&& segment) { media.traverse(o, d, tmax, segment); }, o, d, 1.0, rng,
+                        std::forward<F>(on_collision));
+}
+
+// Free flights through the scene's media: over the analytic pieces where every medium is a constant-density
+// shape (media/analytic_media.h), else cell by cell of the majorant grid.
+template <typename F>
+bool track(const SceneContext& ctx, const Vec3& o, const Vec3& d, double tmax, Rng& rng, F&& on_collision) {
+  if (ctx.analytic.active()) return track(ctx.analytic, o, d, tmax, rng, on_collision);
+  return track(ctx.majorants, o, d, tmax, rng, on_collision);
 }
 
 // The fixed-optical-depth march of the deterministic integrators: each majorant cell's segment of

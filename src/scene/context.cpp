@@ -5,6 +5,7 @@ namespace nimbus {
 SceneContext::SceneContext(const Scene& scene, int majorant_resolution, bool global_majorant)
     : media(scene.media),
       majorants(media, majorant_resolution, global_majorant),
+      analytic(media),
       surfaces(scene.surfaces),
       camera(scene.camera) {
   for (const Light& l : scene.lights) {

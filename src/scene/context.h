@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "core/math.h"
+#include "media/analytic_media.h"
 #include "media/majorant.h"
 #include "media/media.h"
 #include "nimbus/scene.h"
@@ -19,6 +20,8 @@ struct SceneContext {
   explicit SceneContext(const Scene& scene, int majorant_resolution = 0, bool global_majorant = false);
   SceneMedia media;
   MajorantGrid majorants;
+  AnalyticMedia
+      analytic;  // active when every medium is a constant-density sphere or box (media/analytic_media.h)
   SceneSurfaces surfaces;
   PinholeCamera camera;
   std::vector<Light> lights;  // every light but the environment (sampled by NEE)
