@@ -1,9 +1,9 @@
 // The generalised propagator's delay (gsa_delay.h) against photon Monte Carlo at small optical depth
 // (issue 14): the light that never travelled backward, for a Gaussian peak (where the small-angle
 // moments are exact to leading order: asserted within the neglected order <theta^2>), HG 0.9 and 0.95,
-// a double HG and the cloud Mie table (measured and printed; asserted only where derivable: the exact
-// geometry's delay per unit depth, sec(theta) - 1, is never below the small-angle theta^2 / 2, so the
-// Monte Carlo's mean is not below the model's).  Numbers in docs/validation/time.md.
+// a double HG and the cloud Mie table (measured and printed, not asserted: there the model fails both
+// ways, wide deflections delay more than theta^2 / 2 and backward ones count in m2 but not in the
+// forward light).  Numbers in docs/validation/time.md.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -58,9 +58,8 @@ TEST(GsaDelaySlow, ForwardLightAgainstTheCompoundPoissonMoments) {
       for (size_t i = 0; i < t.delay.bins.size(); ++i)
         std::printf(" %.3e/%.3e", t.delay.bins[i].value, g.within(s.time_edges[i], s.time_edges[i + 1]));
       std::printf("\n");
-      EXPECT_LT(mean.err, 0.03 * mean.value);  // power
-      EXPECT_GT(mean.value, g.mean() - 5.0 * mean.err) << c.spec << " " << t.depth;
       if (c.leading_order_exact) {
+        EXPECT_LT(mean.err, 0.03 * mean.value);                              // power
         const double angle2 = dm.m2 * t.depth / (1.0 - std::exp(-t.depth));  // <theta^2> at the plane
         EXPECT_NEAR(mean.value, g.mean(), 5.0 * mean.err + angle2 * g.mean()) << t.depth;
         EXPECT_NEAR(var.value, g.variance(), 5.0 * var.err + 2.0 * angle2 * g.variance()) << t.depth;
