@@ -13,7 +13,7 @@
 //                  models mc, mfs (its closed form) and gsa (a moment-matched gamma law, gsa_delay.h)
 //   delay_mean     lo = hi = 0; mean delay of that light [mfp]
 //   delay_variance lo = hi = 0; its variance [mfp^2]
-//   (model mc_fwd: delay_mean, delay_variance of the photons that never travelled backward)
+//   (model mc_fwd: delay, delay_mean, delay_variance of the photons that never travelled backward)
 // --delay-angle-csv FILE / --delay-radius-csv FILE (need --time-edges): the joint tables of mc,
 //   model,depth,quantity,tlo,thi,lo,hi,value,stderr,bin_unit,value_unit (beam_table.h BeamJointRow)
 #include <fmt/format.h>

@@ -172,6 +172,9 @@ void add_mc_rows(std::vector<BeamRow>& rows, std::vector<BeamJointRow>* joint, c
         rows.push_back({"mc_fwd", t.depth, "angular", te[i], te[i + 1], t.angular_forward_only[i].value,
                         t.angular_forward_only[i].err});
     if (want_fwd && !s.time_edges.empty()) {
+      add_delay_rows(
+          rows, s, "mc_fwd", t.depth, [&](size_t i) { return t.delay_forward_only.bins[i]; },
+          t.delay_forward_only.before, t.delay_forward_only.after);
       rows.push_back({"mc_fwd", t.depth, "delay_mean", 0.0, 0.0, t.delay_mean_forward_only.value,
                       t.delay_mean_forward_only.err});
       rows.push_back({"mc_fwd", t.depth, "delay_variance", 0.0, 0.0, t.delay_variance_forward_only.value,

@@ -28,7 +28,7 @@ struct BeamSettings {
   // the first edge is > 0, a first row from 0 hold the rest), `delay_mean` and `delay_variance`
   // (lo = hi = 0); `mfs` adds the same rows from its closed form (time_resolved.h), `gsa` from the exact
   // small-angle moments of its deflection law and a moment-matched gamma law (gsa_delay.h); the diagnostic
-  // `mc_fwd` adds delay_mean and delay_variance of photons that never travelled backward.
+  // `mc_fwd` adds delay rows, delay_mean and delay_variance of photons that never travelled backward.
   std::vector<double> time_edges;
   // Joint delay x angle and delay x radius tallies of `mc` (need time_edges): rows BeamJointRow.
   bool joint_angle = false, joint_radius = false;

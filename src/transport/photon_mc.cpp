@@ -41,18 +41,20 @@ constexpr double kRouletteSurvival = 0.1;    // MCML
 
 // Offsets of every tally in one flat accumulator per batch.
 // Time tallies take TS = NT + 2 slots (before the first edge, the NT bins, after the last; 0 without
-// time bins) and each plane MS = 6 more (delay moments: weight, weight * delay, weight * delay^2, of all
+// time bins), each plane 2 TS (all scattered forward crossings, and those of photons that never travelled
+// backward) and MS = 6 more (delay moments: weight, weight * delay, weight * delay^2, of all
 // scattered forward crossings and of those by photons that never travelled backward); the joint tallies
 // JA = (NA + 1) TS and JR = (NR + 1) TS slots (the last angle or radius slot: outside the edges).
 struct Layout {
   size_t P, NA, NR, TS = 0, MS = 0, JA = 0, JR = 0;
-  size_t plane_stride() const { return 2 * NA + NR + 1 + TS + MS + JA + JR; }
+  size_t plane_stride() const { return 2 * NA + NR + 1 + 2 * TS + MS + JA + JR; }
   size_t angular(size_t k) const { return k * plane_stride(); }
   size_t radial(size_t k) const { return k * plane_stride() + NA; }
   size_t unscattered(size_t k) const { return k * plane_stride() + NA + NR; }
   size_t angular_forward_only(size_t k) const { return k * plane_stride() + NA + NR + 1; }
   size_t delay(size_t k) const { return k * plane_stride() + 2 * NA + NR + 1; }
-  size_t moments(size_t k) const { return delay(k) + TS; }
+  size_t delay_forward_only(size_t k) const { return delay(k) + TS; }
+  size_t moments(size_t k) const { return delay(k) + 2 * TS; }
   size_t delay_angle(size_t k) const { return moments(k) + MS; }  // + angle slot * TS + time slot
   size_t delay_radius(size_t k) const { return delay_angle(k) + JA; }
   size_t totals() const { return P * plane_stride(); }  // specular, Rd, Tt, Tu, absorbed
@@ -109,7 +111,7 @@ void validate(const PhotonMcSettings& s) {
   if ((s.joint_angle || s.joint_radius) && s.time_edges.empty()) bad("joint tallies need time edges");
   const double joint = (s.joint_angle ? double(s.theta_edges.size() + 1) : 0.0) +
                        (s.joint_radius ? double(s.r_edges.size() + 1) : 0.0);
-  const double slots = double(s.time_edges.size() + 4) * double(s.plane_depths.size() + 2) * (1.0 + joint) +
+  const double slots = double(s.time_edges.size() + 4) * double(s.plane_depths.size() + 2) * (2.0 + joint) +
                        double(s.theta_edges.size() + s.r_edges.size()) * double(s.plane_depths.size() + 2);
   if (slots * double(s.batches) * sizeof(double) > double(1u << 30))
     bad(fmt::format("{} time bins at {} planes need more than 1 GiB of tallies", s.time_edges.size(),
@@ -256,6 +258,7 @@ class Tracer {
   void tally_delay(size_t k, double delay, double w, bool turned, int ia, int ir, double* acc) const {
     const size_t ts = time_slot(s_.time_edges, delay);
     acc[L_.delay(k) + ts] += w;
+    if (!turned) acc[L_.delay_forward_only(k) + ts] += w;
     if (L_.JA > 0) acc[L_.delay_angle(k) + (ia >= 0 ? size_t(ia) : L_.NA) * L_.TS + ts] += w;
     if (L_.JR > 0) acc[L_.delay_radius(k) + (ir >= 0 ? size_t(ir) : L_.NR) * L_.TS + ts] += w;
     double* m = acc + L_.moments(k);
@@ -388,6 +391,8 @@ void add_delay_tallies(PlaneTally& t, const Batches& batches, uint64_t photons, 
   const size_t TS = L.TS;
   t.delay = time_tally(batches, photons, L.delay(k), TS);
   t.delay_weight = batch_estimate(batches, photons, L.moments(k), 1.0);
+  t.delay_forward_only = time_tally(batches, photons, L.delay_forward_only(k), TS);
+  t.delay_weight_forward_only = batch_estimate(batches, photons, L.moments(k) + 3, 1.0);
   t.delay_mean = moment_statistic(batches, L.moments(k), delay_mean);
   t.delay_variance = moment_statistic(batches, L.moments(k), delay_variance);
   t.delay_mean_forward_only = moment_statistic(batches, L.moments(k) + 3, delay_mean);

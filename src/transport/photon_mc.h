@@ -86,6 +86,9 @@ struct PlaneTally {
   TimeTally delay;
   Estimate delay_weight, delay_mean, delay_variance;
   Estimate delay_mean_forward_only, delay_variance_forward_only;
+  // The part of `delay` (bins, before, after) and of delay_weight carried by those photons.
+  TimeTally delay_forward_only;
+  Estimate delay_weight_forward_only;
   // Joint tallies (joint_angle, joint_radius): the same crossings as `delay`, weight per delay bin per
   // source photon, for each bin of theta_edges (delay_angle[i]) or r_edges (delay_radius[i]) and, last,
   // for the crossings outside those edges.  Summed over the angle (or radius) entries they are `delay`;

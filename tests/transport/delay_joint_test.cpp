@@ -1,9 +1,10 @@
 // The photon Monte Carlo's joint delay x angle and delay x radius tallies (issue 14): their marginals are
 // the 1-D tallies of the same photons (to rounding), the crossings outside the angle or radius edges are
-// kept, and asking for them changes no other tally.
+// kept, and asking for them changes no other tally; the forward-only delay bins are part of the delay bins.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include "core/math.h"
@@ -85,6 +86,27 @@ TEST(DelayJoint, MarginalsAreTheOneDimensionalTalliesOfTheSamePhotons) {
     for (size_t j = 0; j < TS; ++j) EXPECT_EQ(slot(u.delay, j), slot(t.delay, j));
     for (size_t i = 0; i < t.angular.size(); ++i) EXPECT_EQ(u.angular[i].value, t.angular[i].value);
     EXPECT_EQ(u.delay_mean.value, t.delay_mean.value);
+  }
+}
+
+TEST(DelayJoint, ForwardOnlyDelayBinsArePartOfTheDelayBins) {
+  PhotonMcSettings s = joint_run();
+  s.joint_angle = s.joint_radius = false;
+  s.thickness = std::numeric_limits<double>::infinity();  // photons that wander deep and return
+  const PhotonMcResult r = run_photon_mc(s);
+  const size_t TS = s.time_edges.size() + 1;
+  for (const PlaneTally& t : r.planes) {
+    double all = 0.0, fwd = 0.0;
+    for (size_t j = 0; j < TS; ++j) {
+      EXPECT_LE(slot(t.delay_forward_only, j), slot(t.delay, j) * (1.0 + 1e-12)) << j;
+      all += slot(t.delay, j);
+      fwd += slot(t.delay_forward_only, j);
+    }
+    EXPECT_NEAR(all, t.delay_weight.value, 1e-12 * all);
+    EXPECT_NEAR(fwd, t.delay_weight_forward_only.value, 1e-12 * fwd);
+    // Power: some light has turned back on its way, and the rest is most of it.
+    EXPECT_LT(fwd, all - 10.0 * t.delay_weight.err);
+    EXPECT_GT(fwd, 0.5 * all);
   }
 }
 
