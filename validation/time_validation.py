@@ -130,15 +130,17 @@ def gsa(photons):
         rows = list(csv.DictReader(io.StringIO(out)))
         for k, z in enumerate([0.25, 1.0]):
             a = ax[k][j]
-            for model, style, label in (("mc", "k.", "photon MC (all light)"), ("gsa", "tab:orange",
-                                                                                "gsa: gamma law, exact moments")):
+            for model, style, label in (("mc", "k.", "photon MC (all light)"),
+                                        ("mc_fwd", "g.", "photon MC (never backward)"),
+                                        ("gsa", "tab:orange", "gsa: gamma law, exact moments")):
                 sel = [r for r in rows if r["model"] == model and abs(float(r["depth"]) - z) < 1e-9]
                 d = [r for r in sel if r["quantity"] == "delay" and math.isfinite(float(r["hi"]))
                      and float(r["lo"]) > 0.0]
                 x = [math.sqrt(float(r["lo"]) * float(r["hi"])) for r in d]
                 y = [float(r["value"]) / math.log(float(r["hi"]) / float(r["lo"])) for r in d]
-                if model == "mc":
-                    a.set_ylim(max(y) * 1e-3, max(y) * 3)
+                if model.startswith("mc"):
+                    if model == "mc":
+                        a.set_ylim(max(y) * 1e-3, max(y) * 3)
                     a.errorbar(x, y, yerr=[float(r["stderr"]) / math.log(float(r["hi"]) / float(r["lo"]))
                                            for r in d], fmt=style, label=label)
                 else:
