@@ -7,8 +7,10 @@ Runs the built `nimbus` (default build/bin/nimbus, or $NIMBUS):
      boundary, integrated over the surface), written into docs/images/time_slab_diffusion.png;
   2. `nimbus beam --time-edges`: the delay n(s - z) of scattered light crossing planes at b z = 0.25, 1, 3
      for a Gaussian forward peak (theta2 = 0.002), Monte Carlo against the corrected MFS kernel's delay
-     density (docs/images/time_beam_delay.png), and prints the mean and variance rows.
-Usage:  /usr/bin/python3 validation/time_validation.py [--photons N]
+     density (docs/images/time_beam_delay.png), and prints the mean and variance rows;
+  3. the generalised propagator's (gsa) delay for HG 0.9 / 0.95, double HG and the cloud Mie table at
+     b z = 0.25, 1: MC against its moment-matched gamma law (docs/images/time_gsa_delay.png).
+Usage:  /usr/bin/python3 validation/time_validation.py [--photons N] [--beam-only | --gsa-only]
 """
 import argparse
 import csv
@@ -115,14 +117,64 @@ def beam(photons):
     fig.savefig(os.path.join(IMAGES, "time_beam_delay.png"), dpi=90)
 
 
+def gsa(photons):
+    """The generalised propagator's delay (moment-matched gamma law) against photon MC at b z = 0.25, 1."""
+    edges = "0," + ",".join("%.6g" % (1e-5 * 10 ** (i / 10.0)) for i in range(61))  # 1e-5 .. 10
+    phases = ["hg:0.9", "hg:0.95", "dhg:0.95,-0.3,0.9", "mie:cloud_mie_550nm"]
+    fig, ax = plt.subplots(2, len(phases), figsize=(4 * len(phases), 7))
+    for j, phase in enumerate(phases):
+        out = subprocess.run([NIMBUS, "beam", "--phase", phase, "--albedo", "1", "--depths", "0.25,1",
+                              "--geometry", "slab:1.5", "--models", "mc,gsa,mc_fwd", "--photons", str(photons),
+                              "--theta-edges", "0,3.14159", "--r-edges", "0,100", "--time-edges", edges],
+                             check=True, capture_output=True, text=True).stdout
+        rows = list(csv.DictReader(io.StringIO(out)))
+        for k, z in enumerate([0.25, 1.0]):
+            a = ax[k][j]
+            for model, style, label in (("mc", "k.", "photon MC (all light)"),
+                                        ("mc_fwd", "g.", "photon MC (never backward)"),
+                                        ("gsa", "tab:orange", "gsa: gamma law, exact moments")):
+                sel = [r for r in rows if r["model"] == model and abs(float(r["depth"]) - z) < 1e-9]
+                d = [r for r in sel if r["quantity"] == "delay" and math.isfinite(float(r["hi"]))
+                     and float(r["lo"]) > 0.0]
+                x = [math.sqrt(float(r["lo"]) * float(r["hi"])) for r in d]
+                y = [float(r["value"]) / math.log(float(r["hi"]) / float(r["lo"])) for r in d]
+                if model.startswith("mc"):
+                    if model == "mc":
+                        a.set_ylim(max(y) * 1e-3, max(y) * 3)
+                    a.errorbar(x, y, yerr=[float(r["stderr"]) / math.log(float(r["hi"]) / float(r["lo"]))
+                                           for r in d], fmt=style, label=label)
+                else:
+                    a.plot(x, y, style, label=label)
+            for model in ("mc", "mc_fwd", "gsa"):
+                sel = [r for r in rows if r["model"] == model and abs(float(r["depth"]) - z) < 1e-9]
+                mean = [r for r in sel if r["quantity"] == "delay_mean"][0]
+                var = [r for r in sel if r["quantity"] == "delay_variance"][0]
+                print("gsa %s z=%g %s: mean %s +- %s, variance %s +- %s" % (
+                    phase, z, model, mean["value"], mean["stderr"], var["value"], var["stderr"]))
+            a.set_xscale("log")
+            a.set_yscale("log")
+            a.set_title("%s, b z = %g" % (phase, z))
+            a.set_xlabel("delay s - z [mean free paths]")
+            a.set_ylabel("scattered light per unit ln(delay)")
+            a.legend(fontsize=7)
+    fig.suptitle("Albedo 1: delay of the scattered light crossing each plane, MC against the gsa gamma law")
+    fig.tight_layout()
+    fig.savefig(os.path.join(IMAGES, "time_gsa_delay.png"), dpi=80)
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--photons", type=int, default=400000)
     ap.add_argument("--beam-only", action="store_true")
+    ap.add_argument("--gsa-only", action="store_true")
     args = ap.parse_args()
+    if args.gsa_only:
+        gsa(args.photons)
+        return
     if not args.beam_only:
         slab(args.photons)
     beam(args.photons)
+    gsa(args.photons)
 
 
 if __name__ == "__main__":

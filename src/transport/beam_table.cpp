@@ -11,6 +11,7 @@
 
 #include "core/math.h"
 #include "nimbus/error.h"
+#include "transport/gsa_delay.h"
 #include "transport/mfs_kernel.h"
 #include "transport/photon_mc.h"
 #include "transport/small_angle.h"
@@ -111,8 +112,42 @@ void add_delay_rows(std::vector<BeamRow>& rows, const BeamSettings& s, const std
       {model, z, "delay", e.back(), std::numeric_limits<double>::infinity(), after.value, after.err});
 }
 
+// The joint rows of one model at one plane: for each angle (or radius) bin of `edges` and the outside
+// slot (lo = hi = -1), the delay bins as add_delay_rows lays them out; value(j, t0, t1) the estimate of
+// bin j (edges.size() - 1: outside) and delay [t0, t1).
+template <typename Value>
+void add_joint_rows(std::vector<BeamJointRow>& rows, const BeamSettings& s, const std::string& model,
+                    double z, const std::string& q, const std::vector<double>& edges, Value&& value) {
+  const auto& e = s.time_edges;
+  const double inf = std::numeric_limits<double>::infinity();
+  for (size_t j = 0; j < edges.size(); ++j) {
+    const bool out = j + 1 == edges.size();
+    const double lo = out ? -1.0 : edges[j], hi = out ? -1.0 : edges[j + 1];
+    auto add = [&](double t0, double t1) {
+      const Estimate v = value(j, t0, t1);
+      rows.push_back({model, z, q, t0, t1, lo, hi, v.value, v.err});
+    };
+    if (e.front() > 0.0) add(0.0, e.front());
+    for (size_t i = 0; i + 1 < e.size(); ++i) add(e[i], e[i + 1]);
+    add(e.back(), inf);
+  }
+}
+
+// The MC's joint rows at plane t: the slots of its TimeTally per bin, found by the delay bin's start.
+void add_mc_joint_rows(std::vector<BeamJointRow>& rows, const BeamSettings& s, const PlaneTally& t,
+                       const std::string& q, const std::vector<double>& edges,
+                       const std::vector<TimeTally>& tallies) {
+  const auto& e = s.time_edges;
+  add_joint_rows(rows, s, "mc", t.depth, q, edges, [&](size_t j, double t0, double) {
+    if (t0 < e.front()) return tallies[j].before;
+    if (t0 >= e.back()) return tallies[j].after;
+    return tallies[j].bins[size_t(std::lower_bound(e.begin(), e.end(), t0) - e.begin())];
+  });
+}
+
 // The photon Monte Carlo rows: "mc" if asked, the forward-only "mc_fwd" diagnostic if want_fwd.
-void add_mc_rows(std::vector<BeamRow>& rows, const BeamSettings& s, double a, bool asked, bool want_fwd) {
+void add_mc_rows(std::vector<BeamRow>& rows, std::vector<BeamJointRow>* joint, const BeamSettings& s,
+                 double a, bool asked, bool want_fwd) {
   const auto& te = s.theta_edges;
   const auto& re = s.r_edges;
   PhotonMcSettings mc;
@@ -128,6 +163,8 @@ void add_mc_rows(std::vector<BeamRow>& rows, const BeamSettings& s, double a, bo
   mc.seed = s.seed;
   mc.batches = s.batches;
   mc.time_edges = s.time_edges;
+  mc.joint_angle = asked && s.joint_angle;
+  mc.joint_radius = asked && s.joint_radius;
   const PhotonMcResult r = run_photon_mc(mc);
   for (const PlaneTally& t : r.planes) {
     if (want_fwd)
@@ -135,6 +172,9 @@ void add_mc_rows(std::vector<BeamRow>& rows, const BeamSettings& s, double a, bo
         rows.push_back({"mc_fwd", t.depth, "angular", te[i], te[i + 1], t.angular_forward_only[i].value,
                         t.angular_forward_only[i].err});
     if (want_fwd && !s.time_edges.empty()) {
+      add_delay_rows(
+          rows, s, "mc_fwd", t.depth, [&](size_t i) { return t.delay_forward_only.bins[i]; },
+          t.delay_forward_only.before, t.delay_forward_only.after);
       rows.push_back({"mc_fwd", t.depth, "delay_mean", 0.0, 0.0, t.delay_mean_forward_only.value,
                       t.delay_mean_forward_only.err});
       rows.push_back({"mc_fwd", t.depth, "delay_variance", 0.0, 0.0, t.delay_variance_forward_only.value,
@@ -151,6 +191,8 @@ void add_mc_rows(std::vector<BeamRow>& rows, const BeamSettings& s, double a, bo
         rows, s, "mc", t.depth, [&](size_t i) { return t.delay.bins[i]; }, t.delay.before, t.delay.after);
     rows.push_back({"mc", t.depth, "delay_mean", 0.0, 0.0, t.delay_mean.value, t.delay_mean.err});
     rows.push_back({"mc", t.depth, "delay_variance", 0.0, 0.0, t.delay_variance.value, t.delay_variance.err});
+    if (mc.joint_angle) add_mc_joint_rows(*joint, s, t, "delay_angle", te, t.delay_angle);
+    if (mc.joint_radius) add_mc_joint_rows(*joint, s, t, "delay_radius", re, t.delay_radius);
   }
 }
 
@@ -169,10 +211,28 @@ void add_mfs_delay_rows(std::vector<BeamRow>& rows, const BeamSettings& s, doubl
   rows.push_back({"mfs", z, "delay_variance", 0.0, 0.0, n * n * m.variance, 0.0});
 }
 
+// The generalised propagator's delay rows at depth z: the exact small-angle moments of its deflection
+// law and the moment-matched gamma law in the bins (gsa_delay.h), times n.
+void add_gsa_delay_rows(std::vector<BeamRow>& rows, const BeamSettings& s, double z, double entry, double a,
+                        const DeflectionMoments& dm) {
+  const GammaDelayLaw g = gsa_delay_law(z, 1.0, a, dm);
+  const double n = s.n, inf = std::numeric_limits<double>::infinity();
+  const auto& e = s.time_edges;
+  auto within = [&](double lo, double hi) { return Estimate{entry * g.within(lo / n, hi / n), 0.0}; };
+  add_delay_rows(
+      rows, s, "gsa", z, [&](size_t i) { return within(e[i], e[i + 1]); }, within(0.0, e.front()),
+      within(e.back(), inf));
+  rows.push_back({"gsa", z, "delay_mean", 0.0, 0.0, n * g.mean(), 0.0});
+  rows.push_back({"gsa", z, "delay_variance", 0.0, 0.0, n * n * g.variance(), 0.0});
+}
+
 }  // namespace
 
-std::vector<BeamRow> beam_table(const BeamSettings& in, const std::vector<std::string>& models) {
+std::vector<BeamRow> beam_table(const BeamSettings& in, const std::vector<std::string>& models,
+                                std::vector<BeamJointRow>* joint) {
   const BeamSettings s = checked_beam_settings(in, models);
+  if ((s.joint_angle || s.joint_radius) && (s.time_edges.empty() || !joint))
+    throw Error("joint delay tables need delay edges and somewhere to put their rows");
   const bool want_fwd = std::find(models.begin(), models.end(), "mc_fwd") != models.end();
   const double a = (1.0 - s.albedo) / s.albedo;  // absorption per scattering length
   const bool slab = std::isfinite(s.thickness);
@@ -183,14 +243,16 @@ std::vector<BeamRow> beam_table(const BeamSettings& in, const std::vector<std::s
     const bool asked = std::find(models.begin(), models.end(), m) != models.end();
     if (!asked && !(m == "mc" && want_fwd)) continue;
     if (m == "mc") {
-      add_mc_rows(rows, s, a, asked, want_fwd);
+      add_mc_rows(rows, joint, s, a, asked, want_fwd);
     } else if (m == "gsa") {
       const ForwardPropagator prop(s.phase);
+      const DeflectionMoments dm = s.time_edges.empty() ? DeflectionMoments{} : deflection_moments(s.phase);
       for (double z : s.depths) {
         const ForwardProfile p = prop.profile(z, a * z);
         add_model_rows(
             rows, s, m, z, entry, a, [&](double t) { return p.angular_within(t); },
             [&](double r) { return p.radial_within(r); });
+        if (!s.time_edges.empty()) add_gsa_delay_rows(rows, s, z, entry, a, dm);
       }
     } else {
       const GaussianModel gm = m == "dolin"   ? GaussianModel::Dolin

@@ -41,17 +41,22 @@ constexpr double kRouletteSurvival = 0.1;    // MCML
 
 // Offsets of every tally in one flat accumulator per batch.
 // Time tallies take TS = NT + 2 slots (before the first edge, the NT bins, after the last; 0 without
-// time bins) and each plane MS = 6 more (delay moments: weight, weight * delay, weight * delay^2, of all
-// scattered forward crossings and of those by photons that never travelled backward).
+// time bins), each plane 2 TS (all scattered forward crossings, and those of photons that never travelled
+// backward) and MS = 6 more (delay moments: weight, weight * delay, weight * delay^2, of all
+// scattered forward crossings and of those by photons that never travelled backward); the joint tallies
+// JA = (NA + 1) TS and JR = (NR + 1) TS slots (the last angle or radius slot: outside the edges).
 struct Layout {
-  size_t P, NA, NR, TS = 0, MS = 0;
-  size_t plane_stride() const { return 2 * NA + NR + 1 + TS + MS; }
+  size_t P, NA, NR, TS = 0, MS = 0, JA = 0, JR = 0;
+  size_t plane_stride() const { return 2 * NA + NR + 1 + 2 * TS + MS + JA + JR; }
   size_t angular(size_t k) const { return k * plane_stride(); }
   size_t radial(size_t k) const { return k * plane_stride() + NA; }
   size_t unscattered(size_t k) const { return k * plane_stride() + NA + NR; }
   size_t angular_forward_only(size_t k) const { return k * plane_stride() + NA + NR + 1; }
   size_t delay(size_t k) const { return k * plane_stride() + 2 * NA + NR + 1; }
-  size_t moments(size_t k) const { return delay(k) + TS; }
+  size_t delay_forward_only(size_t k) const { return delay(k) + TS; }
+  size_t moments(size_t k) const { return delay(k) + 2 * TS; }
+  size_t delay_angle(size_t k) const { return moments(k) + MS; }  // + angle slot * TS + time slot
+  size_t delay_radius(size_t k) const { return delay_angle(k) + JA; }
   size_t totals() const { return P * plane_stride(); }  // specular, Rd, Tt, Tu, absorbed
   size_t reflect_angular() const { return totals() + 5; }
   size_t reflect_radial() const { return reflect_angular() + NA; }
@@ -103,7 +108,10 @@ void validate(const PhotonMcSettings& s) {
   }
   if (s.time_edges.size() == 1) bad("time edges need at least two values");
   // Every batch holds all tallies: refuse what would not fit in memory (1 GiB of tallies).
-  const double slots = double(s.time_edges.size() + 4) * double(s.plane_depths.size() + 2) +
+  if ((s.joint_angle || s.joint_radius) && s.time_edges.empty()) bad("joint tallies need time edges");
+  const double joint = (s.joint_angle ? double(s.theta_edges.size() + 1) : 0.0) +
+                       (s.joint_radius ? double(s.r_edges.size() + 1) : 0.0);
+  const double slots = double(s.time_edges.size() + 4) * double(s.plane_depths.size() + 2) * (2.0 + joint) +
                        double(s.theta_edges.size() + s.r_edges.size()) * double(s.plane_depths.size() + 2);
   if (slots * double(s.batches) * sizeof(double) > double(1u << 30))
     bad(fmt::format("{} time bins at {} planes need more than 1 GiB of tallies", s.time_edges.size(),
@@ -240,14 +248,19 @@ class Tracer {
         const int ir = bin_of(s_.r_edges, std::hypot(p0.x + d.x * t, p0.y + d.y * t));
         if (ir >= 0) acc[L_.radial(k) + ir] += w;
         // The delay is >= 0; rounding could push a nearly straight path a hair below.
-        if (L_.TS > 0) tally_delay(k, std::max(0.0, s_.n * (path + t - zs[k])), w, turned, acc);
+        if (L_.TS > 0) tally_delay(k, std::max(0.0, s_.n * (path + t - zs[k])), w, turned, ia, ir, acc);
       }
     }
   }
 
   // A scattered forward crossing of plane k with delay n (s - z_k).
-  void tally_delay(size_t k, double delay, double w, bool turned, double* acc) const {
-    acc[L_.delay(k) + time_slot(s_.time_edges, delay)] += w;
+  // ia, ir: its angle and radius bins (-1 outside the edges), for the joint tallies.
+  void tally_delay(size_t k, double delay, double w, bool turned, int ia, int ir, double* acc) const {
+    const size_t ts = time_slot(s_.time_edges, delay);
+    acc[L_.delay(k) + ts] += w;
+    if (!turned) acc[L_.delay_forward_only(k) + ts] += w;
+    if (L_.JA > 0) acc[L_.delay_angle(k) + (ia >= 0 ? size_t(ia) : L_.NA) * L_.TS + ts] += w;
+    if (L_.JR > 0) acc[L_.delay_radius(k) + (ir >= 0 ? size_t(ir) : L_.NR) * L_.TS + ts] += w;
     double* m = acc + L_.moments(k);
     for (int part = 0; part < (turned ? 1 : 2); ++part, m += 3) {
       m[0] += w;
@@ -362,14 +375,40 @@ Estimate moment_statistic(const Batches& batches, size_t j, double (*f)(double, 
 double delay_mean(double m0, double m1, double) { return m1 / m0; }
 double delay_variance(double m0, double m1, double m2) { return m2 / m0 - (m1 / m0) * (m1 / m0); }
 
+Layout layout_of(const PhotonMcSettings& s) {
+  const size_t NA = s.theta_edges.size() >= 2 ? s.theta_edges.size() - 1 : 0;
+  const size_t NR = s.r_edges.size() >= 2 ? s.r_edges.size() - 1 : 0;
+  const size_t TS = s.time_edges.empty() ? 0 : s.time_edges.size() + 1;
+  Layout L{s.plane_depths.size(), NA, NR, TS};
+  L.MS = TS > 0 ? 6 : 0;
+  L.JA = s.joint_angle ? (NA + 1) * TS : 0;
+  L.JR = s.joint_radius ? (NR + 1) * TS : 0;
+  return L;
+}
+
+// The delay tallies of plane k (with time bins).
+void add_delay_tallies(PlaneTally& t, const Batches& batches, uint64_t photons, const Layout& L, size_t k) {
+  const size_t TS = L.TS;
+  t.delay = time_tally(batches, photons, L.delay(k), TS);
+  t.delay_weight = batch_estimate(batches, photons, L.moments(k), 1.0);
+  t.delay_forward_only = time_tally(batches, photons, L.delay_forward_only(k), TS);
+  t.delay_weight_forward_only = batch_estimate(batches, photons, L.moments(k) + 3, 1.0);
+  t.delay_mean = moment_statistic(batches, L.moments(k), delay_mean);
+  t.delay_variance = moment_statistic(batches, L.moments(k), delay_variance);
+  t.delay_mean_forward_only = moment_statistic(batches, L.moments(k) + 3, delay_mean);
+  t.delay_variance_forward_only = moment_statistic(batches, L.moments(k) + 3, delay_variance);
+  for (size_t i = 0; L.JA > 0 && i <= L.NA; ++i)
+    t.delay_angle.push_back(time_tally(batches, photons, L.delay_angle(k) + i * TS, TS));
+  for (size_t i = 0; L.JR > 0 && i <= L.NR; ++i)
+    t.delay_radius.push_back(time_tally(batches, photons, L.delay_radius(k) + i * TS, TS));
+}
+
 }  // namespace
 
 PhotonMcResult run_photon_mc(const PhotonMcSettings& s) {
   validate(s);
-  const size_t NA = s.theta_edges.size() >= 2 ? s.theta_edges.size() - 1 : 0;
-  const size_t NR = s.r_edges.size() >= 2 ? s.r_edges.size() - 1 : 0;
-  const size_t TS = s.time_edges.empty() ? 0 : s.time_edges.size() + 1;
-  const Layout L{s.plane_depths.size(), NA, NR, TS, TS > 0 ? size_t(6) : size_t(0)};
+  const Layout L = layout_of(s);
+  const size_t NA = L.NA, NR = L.NR, TS = L.TS;
   const Batches batches = trace_batches(s, L);
   auto estimate = [&](size_t j, double scale) { return batch_estimate(batches, s.photons, j, scale); };
   auto solid_angle = [&](size_t i) {
@@ -389,14 +428,7 @@ PhotonMcResult run_photon_mc(const PhotonMcSettings& s) {
     }
     for (size_t i = 0; i < NR; ++i) t.radial.push_back(estimate(L.radial(k) + i, 1.0 / area(i)));
     t.unscattered = estimate(L.unscattered(k), 1.0);
-    if (TS > 0) {
-      t.delay = time_tally(batches, s.photons, L.delay(k), TS);
-      t.delay_weight = estimate(L.moments(k), 1.0);
-      t.delay_mean = moment_statistic(batches, L.moments(k), delay_mean);
-      t.delay_variance = moment_statistic(batches, L.moments(k), delay_variance);
-      t.delay_mean_forward_only = moment_statistic(batches, L.moments(k) + 3, delay_mean);
-      t.delay_variance_forward_only = moment_statistic(batches, L.moments(k) + 3, delay_variance);
-    }
+    if (TS > 0) add_delay_tallies(t, batches, s.photons, L, k);
     r.planes.push_back(std::move(t));
   }
   r.specular = estimate(L.totals() + kSpecular, 1.0);

@@ -27,7 +27,8 @@
 // Time (issue 14; with time_edges): a photon's time is n times its path length in the medium (c = 1 in
 // vacuum).  Exits are binned by their time (reflect_time, transmit_time: weight per bin, per source
 // photon, not per unit time), and scattered forward crossings (cos theta > 0) of each plane z_k by their
-// delay n (s - z_k), with the weighted moments of that delay.  Every tallied event lands in exactly one
+// delay n (s - z_k), with the weighted moments of that delay, and (joint_angle, joint_radius) by delay
+// and angle or delay and radius.  Every tallied event lands in exactly one
 // bin or in `before`/`after`, so the bins with those two sum to the steady tally of the same photons.
 // Determinism: photon i draws from Rng(seed, i), photons are grouped in batches (standard errors from
 // the spread of batch means) and batches are summed in order, so results do not depend on threads.
@@ -54,6 +55,9 @@ struct PhotonMcSettings {
   uint64_t seed = 1;
   int batches = 16;                // >= 10 for standard errors
   std::vector<double> time_edges;  // [length]; empty: no time tallies; else >= 2, increasing, >= 0
+  // Joint tallies (need time_edges): scattered forward crossings of each plane by delay and polar angle,
+  // and by delay and radius (PlaneTally::delay_angle, delay_radius).
+  bool joint_angle = false, joint_radius = false;
 };
 
 struct Estimate {
@@ -82,6 +86,15 @@ struct PlaneTally {
   TimeTally delay;
   Estimate delay_weight, delay_mean, delay_variance;
   Estimate delay_mean_forward_only, delay_variance_forward_only;
+  // The part of `delay` (bins, before, after) and of delay_weight carried by those photons.
+  TimeTally delay_forward_only;
+  Estimate delay_weight_forward_only;
+  // Joint tallies (joint_angle, joint_radius): the same crossings as `delay`, weight per delay bin per
+  // source photon, for each bin of theta_edges (delay_angle[i]) or r_edges (delay_radius[i]) and, last,
+  // for the crossings outside those edges.  Summed over the angle (or radius) entries they are `delay`;
+  // summed over time, delay_radius[i] is radial[i] times the annulus area, and delay_angle[i] is the
+  // forward flux of the bin (angular[i] times its solid angle and a cos theta of the bin).
+  std::vector<TimeTally> delay_angle, delay_radius;
 };
 
 struct PhotonMcResult {

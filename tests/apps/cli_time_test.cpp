@@ -11,6 +11,7 @@
 #include <map>
 #include <sstream>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "support/cli.h"
@@ -90,6 +91,75 @@ TEST(CliTime, BeamAddsDelayRowsForMcAndMfs) {
     EXPECT_EQ(count[std::string(m) + ":delay_mean"], 2) << m;
     EXPECT_EQ(count[std::string(m) + ":delay_variance"], 2) << m;
   }
+}
+
+std::vector<std::vector<std::string>> read_rows(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  std::vector<std::vector<std::string>> rows;
+  std::string line;
+  while (std::getline(in, line)) rows.push_back(split(line));
+  return rows;
+}
+
+TEST(CliTime, BeamJointTablesSumToTheDelayRows) {
+  const auto dir = temp_dir();
+  const auto angle = dir / "angle.csv", radius = dir / "radius.csv";
+  const CliRun r = run_cli(
+      "beam --phase hg:0.9 --albedo 0.99 --depths 0.5,1 --photons 4000 --models mc,mfs,gsa "
+      "--theta-edges 0,0.1,0.5 --r-edges 0,0.3,1 --time-edges 0.01,0.1,1 --delay-angle-csv " +
+      angle.string() + " --delay-radius-csv " + radius.string());
+  ASSERT_EQ(r.rc, 0) << r.out;
+  std::map<std::string, double> delay;  // "model:depth:tlo" -> delay row
+  std::stringstream ss(r.out);
+  std::string line;
+  int gsa_rows = 0;
+  while (std::getline(ss, line)) {
+    const auto v = split(line);
+    if (v.size() == 9 && v[2] == "delay" && v[0] != "gsa")
+      delay[v[0] + ":" + v[1] + ":" + v[3]] = std::stod(v[5]);
+    if (v.size() == 9 && v[0] == "gsa" && v[2].rfind("delay", 0) == 0) ++gsa_rows;
+  }
+  EXPECT_EQ(gsa_rows, 2 * (4 + 2));  // 0..0.01, two bins, the tail; mean and variance; per depth
+  ASSERT_EQ(delay.size(), 2u * 2u * 4u);
+  for (const auto& [path, q, bins] :
+       {std::tuple{angle, "delay_angle", 2}, std::tuple{radius, "delay_radius", 2}}) {
+    const auto rows = read_rows(path);
+    ASSERT_FALSE(rows.empty());
+    EXPECT_EQ(rows[0].size(), 11u);
+    EXPECT_EQ(rows[0][3], "tlo");
+    // depths x time rows x (bins + outside), mc only
+    EXPECT_EQ(rows.size(), 1u + 2u * 4u * (bins + 1u)) << q;
+    std::map<std::string, double> sum;
+    for (size_t i = 1; i < rows.size(); ++i) {
+      EXPECT_EQ(rows[i][2], q);
+      sum[rows[i][0] + ":" + rows[i][1] + ":" + rows[i][3]] += std::stod(rows[i][7]);
+    }
+    for (const auto& [key, v] : delay)  // the same tallies, to the 9 digits printed
+      if (key.rfind("mc:", 0) == 0) EXPECT_NEAR(sum[key], v, 1e-8 * v + 1e-15) << q << " " << key;
+  }
+  std::filesystem::remove_all(dir);
+}
+
+TEST(CliTime, BeamBadJointTablesExitWithCode2NamingTheArgument) {
+  const auto dir = temp_dir();
+  const auto out = dir / "never.csv";
+  const std::string beam = "beam --phase hg:0.9 --albedo 0.9 --photons 100 --depths 1 ";
+  const struct {
+    std::string args, named;
+  } cases[] = {
+      {"--delay-angle-csv " + out.string(), "--delay-angle-csv"},  // no --time-edges
+      {"--time-edges 0,1 --delay-radius-csv " + (dir / "no" / "x.csv").string(), "--delay-radius-csv"},
+      {"--time-edges 0,1 --delay-angle-csv -", "--delay-angle-csv"},
+      {"--time-edges 0:1:50000 --delay-angle-csv " + out.string(), "--delay-angle-csv"},  // memory
+      {"--time-edges 0,1 --models gsa,mfs --delay-radius-csv " + out.string(), "--delay-radius-csv"},
+  };
+  for (const auto& c : cases) {
+    const CliRun r = run_cli(beam + c.args);
+    EXPECT_EQ(r.rc, 2) << c.args << ": " << r.out;
+    EXPECT_NE(r.out.find(c.named), std::string::npos) << c.args << ": " << r.out;
+  }
+  EXPECT_FALSE(std::filesystem::exists(out));
+  std::filesystem::remove_all(dir);
 }
 
 const char* const kBadEdges[] = {"''", "2,1", "-1,1", "0:1:1e9", "5"};
