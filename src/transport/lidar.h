@@ -22,8 +22,10 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <vector>
 
+#include "core/rng.h"
 #include "media/phase.h"
 #include "transport/photon_mc.h"
 
@@ -56,6 +58,20 @@ void validate_lidar(const LidarSettings& s, bool monte_carlo);
 
 // Deterministic for a seed, whatever the number of threads (photon i draws from Rng(seed, i)).
 LidarMcResult run_lidar_mc(const LidarSettings& s);
+
+// The photon driver of both lidars (this slab's and the scene's, integrators/lidar_scene.h): `photons`
+// histories in `batches`, photon k drawing from Rng(seed, k), trace(rng, acc) adding to acc[0, slots);
+// batches summed in order, so the result has the same bits for any thread count.  Each slot's mean per
+// photon with its batch standard error, and the same for the sum of the first `summed` slots.
+// The accumulator slot of time t: 0 before edges[0], i for [edges[i-1], edges[i]), edges.size() after.
+size_t lidar_time_slot(const std::vector<double>& edges, double t);
+
+struct BatchTally {
+  std::vector<Estimate> slots;
+  Estimate sum;
+};
+BatchTally run_photon_batches(uint64_t photons, int batches, uint64_t seed, size_t slots, size_t summed,
+                              const std::function<void(Rng&, double*)>& trace);
 
 // The single-scatter lidar equation per bin [1/length^2 per photon] (see above).
 std::vector<double> lidar_single_scatter(const LidarSettings& s);

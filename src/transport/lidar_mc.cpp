@@ -36,6 +36,12 @@ void validate_lidar(const LidarSettings& s, bool monte_carlo) {
   if (s.photons < uint64_t(s.batches)) bad("needs at least one photon per batch");
 }
 
+size_t lidar_time_slot(const std::vector<double>& edges, double t) {
+  if (t < edges.front()) return 0;
+  if (t >= edges.back()) return edges.size();
+  return size_t(std::upper_bound(edges.begin(), edges.end(), t) - edges.begin());
+}
+
 namespace {
 
 constexpr double kRouletteThreshold = 1e-4;  // MCML
@@ -47,12 +53,6 @@ struct LidarLayout {
   size_t analog() const { return TS; }
   size_t size() const { return TS + 1; }
 };
-
-size_t slot_of(const std::vector<double>& edges, double t) {
-  if (t < edges.front()) return 0;
-  if (t >= edges.back()) return edges.size();
-  return size_t(std::upper_bound(edges.begin(), edges.end(), t) - edges.begin());
-}
 
 // One photon history.
 class LidarTracer {
@@ -103,7 +103,7 @@ class LidarTracer {
     if (cos_r < cos_fov_) return;
     const double inside = L * (p.z - s_.distance) / p.z;  // the part of the return leg in the slab
     const double e = w * phase_eval(s_.phase, dot(d, u)) * std::exp(-sigma_t_ * inside) * cos_r / (L * L);
-    acc[slot_of(s_.time_edges, s_.n * (path + L))] += e;
+    acc[lidar_time_slot(s_.time_edges, s_.n * (path + L))] += e;
   }
 
   // The analog tally: a photon leaving through the near face that crosses the gap into the disk within
@@ -119,60 +119,59 @@ class LidarTracer {
   double sigma_t_, cos_fov_;
 };
 
-struct LidarBatches {
-  std::vector<std::vector<double>> sums;
-  std::vector<uint64_t> counts;
-};
-
-// Mean over all photons of f(batch sums), standard error from the spread of batch means.
-template <class F>
-Estimate batch_mean(const LidarBatches& b, uint64_t photons, F f) {
-  const int B = int(b.sums.size());
-  const double N = double(photons);
-  double total = 0.0;
-  for (int i = 0; i < B; ++i) total += f(b.sums[i]);
-  const double mean = total / N;
-  double var = 0.0;
-  for (int i = 0; i < B; ++i) {
-    const double fb = double(b.counts[i]) / N, xb = f(b.sums[i]) / double(b.counts[i]);
-    var += fb * fb * (xb - mean) * (xb - mean);
-  }
-  return Estimate{mean, std::sqrt(var * double(B) / double(B - 1))};
-}
-
 }  // namespace
+
+BatchTally run_photon_batches(uint64_t photons, int batches, uint64_t seed, size_t slots, size_t summed,
+                              const std::function<void(Rng&, double*)>& trace) {
+  const int B = batches;
+  std::vector<std::vector<double>> sums(B, std::vector<double>(slots, 0.0));
+  std::vector<uint64_t> first(B), counts(B);
+  for (int i = 0; i < B; ++i) {
+    counts[i] = photons / B + (uint64_t(i) < photons % B ? 1 : 0);
+    first[i] = i == 0 ? 0 : first[i - 1] + counts[i - 1];
+  }
+  tbb::parallel_for(tbb::blocked_range<int>(0, B, 1), [&](const tbb::blocked_range<int>& range) {
+    for (int i = range.begin(); i < range.end(); ++i)
+      for (uint64_t k = first[i]; k < first[i] + counts[i]; ++k) {
+        Rng rng(seed, k);
+        trace(rng, sums[i].data());
+      }
+  });
+  // Mean over all photons of f(batch sums), standard error from the spread of batch means.
+  const double N = double(photons);
+  auto batch_mean = [&](auto f) {
+    double total = 0.0;
+    for (int i = 0; i < B; ++i) total += f(sums[i]);
+    const double mean = total / N;
+    double var = 0.0;
+    for (int i = 0; i < B; ++i) {
+      const double fb = double(counts[i]) / N, xb = f(sums[i]) / double(counts[i]);
+      var += fb * fb * (xb - mean) * (xb - mean);
+    }
+    return Estimate{mean, std::sqrt(var * double(B) / double(B - 1))};
+  };
+  BatchTally r;
+  for (size_t j = 0; j < slots; ++j) r.slots.push_back(batch_mean([j](const auto& v) { return v[j]; }));
+  r.sum = batch_mean([&](const auto& v) {
+    double t = 0.0;
+    for (size_t j = 0; j < summed; ++j) t += v[j];
+    return t;
+  });
+  return r;
+}
 
 LidarMcResult run_lidar_mc(const LidarSettings& s) {
   validate_lidar(s, true);
   const LidarLayout L{s.time_edges.size() + 1};
-  const int B = s.batches;
-  LidarBatches b;
-  b.sums.assign(B, std::vector<double>(L.size(), 0.0));
-  std::vector<uint64_t> first(B);
-  b.counts.resize(B);
-  for (int i = 0; i < B; ++i) {
-    b.counts[i] = s.photons / B + (uint64_t(i) < s.photons % B ? 1 : 0);
-    first[i] = i == 0 ? 0 : first[i - 1] + b.counts[i - 1];
-  }
   const LidarTracer tracer(s, L);
-  tbb::parallel_for(tbb::blocked_range<int>(0, B, 1), [&](const tbb::blocked_range<int>& range) {
-    for (int i = range.begin(); i < range.end(); ++i)
-      for (uint64_t k = first[i]; k < first[i] + b.counts[i]; ++k) {
-        Rng rng(s.seed, k);
-        tracer.trace(rng, b.sums[i].data());
-      }
-  });
+  const BatchTally b = run_photon_batches(s.photons, s.batches, s.seed, L.size(), L.TS,
+                                          [&](Rng& rng, double* acc) { tracer.trace(rng, acc); });
   LidarMcResult r;
-  auto slot = [&](size_t j) { return batch_mean(b, s.photons, [j](const auto& v) { return v[j]; }); };
-  r.received.before = slot(0);
-  for (size_t j = 1; j + 1 < L.TS; ++j) r.received.bins.push_back(slot(j));
-  r.received.after = slot(L.TS - 1);
-  r.total = batch_mean(b, s.photons, [&](const auto& v) {
-    double t = 0.0;
-    for (size_t j = 0; j < L.TS; ++j) t += v[j];
-    return t;
-  });
-  r.analog = slot(L.analog());
+  r.received.before = b.slots[0];
+  for (size_t j = 1; j + 1 < L.TS; ++j) r.received.bins.push_back(b.slots[j]);
+  r.received.after = b.slots[L.TS - 1];
+  r.total = b.sum;
+  r.analog = b.slots[L.analog()];
   return r;
 }
 
