@@ -8,12 +8,15 @@
 
 #include <cmath>
 #include <functional>
+#include <nlohmann/json.hpp>
 #include <vector>
 
 #include "core/math.h"
 #include "core/rng.h"
 #include "media/phase.h"
 #include "nimbus/error.h"
+#include "nimbus/scene.h"
+#include "support/scenes.h"
 #include "transport/phase_spec.h"
 #include "transport/phase_split.h"
 
@@ -159,6 +162,34 @@ TEST(FournierForand, SpecsAndPeakSplit) {
     EXPECT_GE(split.wide(mu), 0.0);
     EXPECT_NEAR(split.f() * split.peak(mu) + (1 - split.f()) * split.wide(mu), phase_eval(a, mu),
                 1e-9 * phase_eval(a, mu));
+  }
+}
+
+TEST(FournierForand, SceneFilePhase) {
+  auto scene = [](const std::string& phase) {
+    return parse_scene(
+        nlohmann::json::parse(
+            "{" + test::camera_json() +
+            R"(, "media": [{"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1},
+                 "sigma_s": 1, "phase": )" +
+            phase + R"(}], "lights": [{"type": "directional", "direction": [0, 0, -1], "irradiance": 1}]})"),
+        "scene.json", ".");
+  };
+  const Scene s = scene(R"({"type": "fournier_forand", "n": 1.1, "mu": 3.5835})");
+  EXPECT_NEAR(phase_mean_cosine(s.media[0].phase), phase_mean_cosine(Phase(make_ff_phase(1.1, 3.5835))),
+              1e-12);
+  for (const auto& [phase, field] : std::vector<std::pair<std::string, std::string>>{
+           {R"({"type": "fournier_forand", "n": 2, "mu": 3.5})", "scene.json: /media/0/phase/n"},
+           {R"({"type": "fournier_forand", "n": 1.1, "mu": 3})", "scene.json: /media/0/phase/mu"},
+           {R"({"type": "fournier_forand", "n": 1.1})", "scene.json: /media/0/phase/mu"},
+           {R"({"type": "fournier_forand", "n": 1.1, "mu": 3.5, "g": 0.9})",
+            "scene.json: /media/0/phase/g"}}) {
+    try {
+      scene(phase);
+      ADD_FAILURE() << phase;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(field), std::string::npos) << e.what();
+    }
   }
 }
 
