@@ -39,6 +39,7 @@ struct LidarArgs {
   std::optional<double> mu_s, thickness, distance, mu_a, albedo, g;
   std::string phase, time_edges, models, out;          // models: empty for the default
   std::string scene, origin = "0,0,0", dir = "0,0,1";  // --scene mode
+  std::string surface = "matched";
   int channel = 1;
   uint64_t seed = 1;
 };
@@ -93,6 +94,10 @@ LidarSettings lidar_settings(const LidarArgs& a) {
     throw Error(fmt::format("--thickness must be finite and > 0 (got {})", *a.thickness));
   s.thickness = *a.thickness;
   s.distance = a.distance.value_or(0.0);
+  if (a.surface != "matched" && a.surface != "fresnel")
+    throw Error(fmt::format("--surface must be matched or fresnel (got '{}')", a.surface));
+  s.fresnel = a.surface == "fresnel";
+  if (s.fresnel && !(s.distance > 0.0)) throw Error("--surface fresnel needs --distance > 0 (the air gap)");
   if (!(s.distance >= 0.0) || !std::isfinite(s.distance))
     throw Error(fmt::format("--distance must be finite and >= 0 (got {})", s.distance));
   receiver_settings(a, s);
@@ -115,6 +120,7 @@ std::vector<std::string> lidar_models(const std::string& list) {
 
 // --scene: the checked options for cmd_lidar_scene.cpp.
 SceneLidarRequest scene_lidar_request(const LidarArgs& a, const std::vector<std::string>& models) {
+  if (a.surface != "matched") throw Error("--surface: not available with --scene (a slab's top face)");
   if (a.mu_s || a.mu_a || a.albedo || a.g || !a.phase.empty() || a.thickness || a.distance)
     throw Error(
         "--scene: the scene gives the medium; leave out --mu-s, --mu-a, --albedo, --g, --phase, "
@@ -137,8 +143,9 @@ int run_lidar(const LidarArgs& a) {
   auto row = [&](const std::string& m, double lo, double hi, double v, double err) {
     text += fmt::format("{},{:.9g},{:.9g},{:.9g},{:.9g},length,1/length^2 per photon\n", m, lo, hi, v, err);
   };
+  const bool plain = a.scene.empty() && a.surface == "matched";
   const std::vector<std::string> models = lidar_models(!a.models.empty() ? a.models
-                                                       : a.scene.empty() ? "mc,mfs,single"
+                                                       : plain           ? "mc,mfs,single"
                                                                          : "mc,single");
   if (!a.scene.empty()) {
     scene_lidar_rows(scene_lidar_request(a, models), row);
@@ -146,6 +153,10 @@ int run_lidar(const LidarArgs& a) {
   }
   if (a.origin != "0,0,0" || a.dir != "0,0,1" || a.channel != 1)
     throw Error("--origin, --dir and --channel need --scene");
+  if (a.surface == "fresnel")
+    for (const std::string& m : models)
+      if (m == "mfs")
+        throw Error("--models: mfs has no Fresnel surface (use mc, single with --surface fresnel)");
   const LidarSettings s = lidar_settings(a);
   const std::vector<double>& e = s.time_edges;
   const double inf = std::numeric_limits<double>::infinity();
@@ -167,6 +178,7 @@ int run_lidar(const LidarArgs& a) {
       for (size_t i = 0; i + 1 < e.size(); ++i) row(m, e[i], e[i + 1], v[i], 0.0);
     }
   }
+  if (s.fresnel) row("surface", 2.0 * s.distance, 2.0 * s.distance, lidar_surface_return(s), 0.0);
   return write_text(a.out, text) ? kExitOk : kExitFailure;
 }
 
@@ -193,6 +205,9 @@ void add_lidar_command(CLI::App& app, Action& action) {
   cmd->add_option("--fov", a->fov, "Receiver field of view, half-angle [rad]")->required();
   cmd->add_option("--receiver-radius", a->r_rx, "Receiver disk radius [length] (default 0: a point)");
   cmd->add_option("--time-edges", a->time_edges, "Time-bin edges t0,t1,... or lo:hi:N [length]")->required();
+  cmd->add_option("--surface", a->surface,
+                  "The slab's top face: matched (default: n only scales time) or fresnel (air gap, a water "
+                  "surface of index n that reflects and refracts)");
   cmd->add_option("--scene", a->scene, "Scene file: the lidar looks into its media instead of a slab");
   cmd->add_option("--origin", a->origin, "With --scene: the lidar's position x,y,z (default 0,0,0)");
   cmd->add_option("--dir", a->dir, "With --scene: the direction it looks, x,y,z (default 0,0,1)");

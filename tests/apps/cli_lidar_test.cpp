@@ -101,6 +101,9 @@ TEST(CliLidar, BadMediumOrModelsExitTwoAndTheOutputIsCheckedFirst) {
   expect_refused({
       {"--fov 0.01 --mu-a 0.1 --time-edges 1,2", "--albedo"},
       {"--fov 0.01 --models mc,foo --time-edges 1,2", "--models"},
+      {"--fov 0.01 --time-edges 1,2 --surface glass", "--surface"},
+      {"--fov 0.01 --time-edges 1,2 --surface fresnel", "--distance"},
+      {"--fov 0.01 --time-edges 1,2 --surface fresnel --distance 1 --models mfs", "--models"},
   });
   // The output path is checked before any work (a billion photons would take hours).
   const CliRun r = run_cli(
@@ -154,6 +157,7 @@ TEST(CliLidar, BadSceneInputExitsTwoNamingFileAndField) {
       {"--scene " + good + " --dir 1,2", {"--dir"}},
       {"--scene " + good + " --origin 1,2,x", {"--origin"}},
       {"--scene " + good + " --channel 3", {"--channel"}},
+      {"--scene " + good + " --surface fresnel", {"--surface"}},
       {"--mu-s 1 --albedo 0.9 --g 0.9 --thickness 2 --origin 1,1,1", {"--origin"}},
       {"--albedo 0.9 --g 0.9 --thickness 2", {"--mu-s"}},
   };
@@ -163,6 +167,25 @@ TEST(CliLidar, BadSceneInputExitsTwoNamingFileAndField) {
     for (const std::string& n : named) EXPECT_NE(r.out.find(n), std::string::npos) << args << "\n" << r.out;
     EXPECT_FALSE(std::filesystem::exists(out)) << args;
   }
+}
+
+TEST(CliLidar, FresnelSurfaceRowAndDefaultModels) {
+  const auto out = temp_dir() / "fresnel.csv";
+  const CliRun r = run_cli(
+      "lidar --mu-s 1 --albedo 0.9 --g 0.9 --thickness 2 --distance 1 --n 1.33 --surface fresnel --fov 0.05 "
+      "--receiver-radius 0.1 --photons 2000 --time-edges 2:6:4 -o " +
+      out.string());
+  ASSERT_EQ(r.rc, 0) << r.out;
+  std::ifstream in(out);
+  std::string line;
+  std::map<std::string, std::vector<std::vector<std::string>>> rows;
+  while (std::getline(in, line)) rows[split(line)[0]].push_back(split(line));
+  EXPECT_EQ(rows["mc"].size(), 6u);  // 0..2, four bins, 6..inf
+  EXPECT_EQ(rows["single"].size(), 4u);
+  EXPECT_EQ(rows["mfs"].size(), 0u);
+  ASSERT_EQ(rows["surface"].size(), 1u);
+  EXPECT_EQ(rows["surface"][0][1], "2");  // at twice the gap
+  EXPECT_NEAR(std::stod(rows["surface"][0][3]), std::pow(0.33 / 2.33, 2) / (M_PI * 0.01), 1e-7);
 }
 
 }  // namespace
