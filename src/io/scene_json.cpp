@@ -15,6 +15,7 @@
 #include "io/scene_surfaces.h"
 #include "io/scene_volumes.h"
 #include "io/transform_json.h"
+#include "media/fournier_forand.h"
 #include "media/media.h"
 #include "media/phase.h"
 #include "nimbus/error.h"
@@ -46,8 +47,13 @@ Phase parse_phase(JsonObject o) {
     phase = p;
   } else if (type == "gauss") {
     phase = make_gauss_phase(o.number_open_below("theta2", 0.0, 100.0));
+  } else if (type == "fournier_forand") {
+    const double n = o.number_open_below("n", 1.0, 1.5), mu = o.number_open_below("mu", 3.0, 5.0);
+    phase = make_ff_phase(n, mu);
   } else {
-    o.fail("type", fmt::format("unknown phase function '{}' (known: isotropic, hg, double_hg, gauss)", type));
+    o.fail("type", fmt::format("unknown phase function '{}' (known: isotropic, hg, double_hg, gauss, "
+                               "fournier_forand)",
+                               type));
   }
   o.finish();
   return phase;

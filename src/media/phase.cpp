@@ -42,9 +42,17 @@ double gauss_sphere_integral(double t) {
 }
 
 // Integral of (a + b theta) sin(theta) over [t0, t1].
+// int_t0^t1 (a + b t) sin t dt, without the cancellation of cos t1 - cos t0 at small angles (tables with a
+// steep forward peak, e.g. Fournier-Forand's, have panels at 1e-7 rad): the cosine difference as a
+// product of sines, and sin t - t cos t by its series below 0.1.
 double linear_sin_integral(double a, double b, double t0, double t1) {
-  auto F = [&](double t) { return -a * std::cos(t) + b * (std::sin(t) - t * std::cos(t)); };
-  return F(t1) - F(t0);
+  const double cos_diff = 2.0 * std::sin(0.5 * (t1 + t0)) * std::sin(0.5 * (t1 - t0));  // cos t0 - cos t1
+  auto G = [](double t) {                                                               // sin t - t cos t
+    if (t >= 0.1) return std::sin(t) - t * std::cos(t);
+    const double t2 = t * t;
+    return t * t2 * (1.0 / 3.0 - t2 * (1.0 / 30.0 - t2 * (1.0 / 840.0 - t2 / 45360.0)));
+  };
+  return a * cos_diff + b * (G(t1) - G(t0));
 }
 
 double tabulated_eval_theta(const TabulatedPhase& p, double theta) {
@@ -172,7 +180,24 @@ double phase_mean_cosine(const Phase& phase) {
     double operator()(const HgPhase& p) const { return p.g; }
     double operator()(const DoubleHgPhase& p) const { return p.w * p.g1 + (1.0 - p.w) * p.g2; }
     double operator()(const GaussPhase& p) const { return integrate(p); }
-    double operator()(const TabulatedPhase& p) const { return integrate(p); }
+    double operator()(const TabulatedPhase& p) const {
+      // Panel by panel (the table is linear in theta), 4-point Gauss-Legendre: exact to rounding for the
+      // narrow panels of a forward peak, which a fixed grid in theta would miss.
+      constexpr double x[4] = {-0.8611363115940526, -0.3399810435848563, 0.3399810435848563,
+                               0.8611363115940526};
+      constexpr double w[4] = {0.3478548451374538, 0.6521451548625461, 0.6521451548625461,
+                               0.3478548451374538};
+      double sum = 0.0;
+      for (size_t i = 1; i < p.theta.size(); ++i) {
+        const double t0 = p.theta[i - 1], h = p.theta[i] - t0;
+        for (int q = 0; q < 4; ++q) {
+          const double f = 0.5 * (1.0 + x[q]), th = t0 + f * h;
+          const double v = p.value[i - 1] + f * (p.value[i] - p.value[i - 1]);
+          sum += 0.5 * h * w[q] * v * std::cos(th) * std::sin(th);
+        }
+      }
+      return 2.0 * kPi * sum;
+    }
     double integrate(const Phase& p) const {
       const int n = 20000;
       double sum = 0.0;

@@ -22,8 +22,10 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <vector>
 
+#include "core/rng.h"
 #include "media/phase.h"
 #include "transport/photon_mc.h"
 
@@ -33,9 +35,13 @@ struct LidarSettings {
   double sigma_s = 1.0;  // [1/length]
   double sigma_a = 0.0;  // [1/length]
   Phase phase = HgPhase{0.9};
-  double thickness = 1.0;          // [length], finite
-  double distance = 0.0;           // from the lidar to the slab's near face [length], >= 0
-  double n = 1.0;                  // time = n * path length
+  double thickness = 1.0;  // [length], finite
+  double distance = 0.0;   // from the lidar to the slab's near face [length], >= 0
+  double n = 1.0;          // time = n * path length
+  // A Fresnel top face (air above, index n below): the gap is air (time = gap + n * path in the slab),
+  // the surface reflects (exact unpolarised Fresnel) and refracts; needs distance > 0.  Models: mc and
+  // single (the fused model refuses it).  The bottom face stays matched.
+  bool fresnel = false;
   double r_rx = 0.0;               // receiver radius [length], >= 0
   double fov = 0.01;               // receiver half-angle [rad], in (0, pi/2)
   std::vector<double> time_edges;  // [length], >= 2, increasing, >= 0
@@ -56,6 +62,24 @@ void validate_lidar(const LidarSettings& s, bool monte_carlo);
 
 // Deterministic for a seed, whatever the number of threads (photon i draws from Rng(seed, i)).
 LidarMcResult run_lidar_mc(const LidarSettings& s);
+
+// The photon driver of both lidars (this slab's and the scene's, integrators/lidar_scene.h): `photons`
+// histories in `batches`, photon k drawing from Rng(seed, k), trace(rng, acc) adding to acc[0, slots);
+// batches summed in order, so the result has the same bits for any thread count.  Each slot's mean per
+// photon with its batch standard error, and the same for the sum of the first `summed` slots.
+// The accumulator slot of time t: 0 before edges[0], i for [edges[i-1], edges[i]), edges.size() after.
+size_t lidar_time_slot(const std::vector<double>& edges, double t);
+
+struct BatchTally {
+  std::vector<Estimate> slots;
+  Estimate sum;
+};
+BatchTally run_photon_batches(uint64_t photons, int batches, uint64_t seed, size_t slots, size_t summed,
+                              const std::function<void(Rng&, double*)>& trace);
+
+// The surface's specular return with a Fresnel face: R(0) per photon arriving at t = 2 distance, as energy
+// per unit receiver area (R(0) / (pi r_rx^2); infinite for a point receiver, which it hits).
+double lidar_surface_return(const LidarSettings& s);
 
 // The single-scatter lidar equation per bin [1/length^2 per photon] (see above).
 std::vector<double> lidar_single_scatter(const LidarSettings& s);

@@ -9,6 +9,7 @@
 
 #include "core/rng.h"
 #include "nimbus/error.h"
+#include "transport/fresnel.h"
 #include "transport/lidar.h"
 #include "transport/time_resolved.h"
 
@@ -31,9 +32,16 @@ void validate_lidar(const LidarSettings& s, bool monte_carlo) {
       bad("time edges must be finite and >= 0");
     if (i > 0 && !(s.time_edges[i] > s.time_edges[i - 1])) bad("time edges must increase");
   }
+  if (s.fresnel && !(s.distance > 0.0)) bad("a Fresnel surface needs a gap (distance > 0)");
   if (!monte_carlo) return;
   if (s.batches < 2) bad("needs at least 2 batches");
   if (s.photons < uint64_t(s.batches)) bad("needs at least one photon per batch");
+}
+
+size_t lidar_time_slot(const std::vector<double>& edges, double t) {
+  if (t < edges.front()) return 0;
+  if (t >= edges.back()) return edges.size();
+  return size_t(std::upper_bound(edges.begin(), edges.end(), t) - edges.begin());
 }
 
 namespace {
@@ -48,12 +56,6 @@ struct LidarLayout {
   size_t size() const { return TS + 1; }
 };
 
-size_t slot_of(const std::vector<double>& edges, double t) {
-  if (t < edges.front()) return 0;
-  if (t >= edges.back()) return edges.size();
-  return size_t(std::upper_bound(edges.begin(), edges.end(), t) - edges.begin());
-}
-
 // One photon history.
 class LidarTracer {
  public:
@@ -65,12 +67,13 @@ class LidarTracer {
     const double albedo = s_.sigma_s / sigma_t_;
     const double z0 = s_.distance, z1 = s_.distance + s_.thickness;
     Vec3 p(0.0, 0.0, z0), d(0.0, 0.0, 1.0);  // across the clear gap to the near face
-    double w = 1.0, path = z0;
+    double w = s_.fresnel ? 1.0 - fresnel_reflectance(1.0, s_.n) : 1.0, path = z0;
     while (true) {
-      // Free flight; a photon reaching a face leaves (matched boundaries).
+      // Free flight; a photon reaching a face leaves (matched boundaries; a Fresnel top face reflects).
       const double step = -std::log(1.0 - rng.uniform()) / sigma_t_;
       const double s_face = d.z > 0.0 ? (z1 - p.z) / d.z : d.z < 0.0 ? (z0 - p.z) / d.z : 1e300;
       if (step >= s_face) {
+        if (d.z < 0.0 && reflects(rng, p, d, path, s_face)) continue;
         if (d.z < 0.0) tally_analog(p + d * s_face, d, w, acc);
         return;
       }
@@ -89,6 +92,19 @@ class LidarTracer {
   }
 
  private:
+  // At the Fresnel surface, from below: reflected with probability R (then continues from the surface
+  // point, mirrored); false where the photon leaves (matched faces: always).
+  bool reflects(Rng& rng, Vec3& p, Vec3& d, double& path, double s_face) const {
+    if (!s_.fresnel) return false;
+    const double R = fresnel_reflectance(-d.z, 1.0 / s_.n);
+    if (!(R > 0.0) || rng.uniform() >= R) return false;
+    p += d * s_face;
+    p.z = s_.distance;
+    path += s_face;
+    d.z = -d.z;
+    return true;
+  }
+
   // Local estimate: scatter toward a point y of the receiver (uniform on the disk), no collision on the
   // way back (exp(-sigma_t L_in), L_in the part inside the slab), received irradiance cos / L^2 if the
   // arriving direction lies within the FOV.  Always draws two numbers (the same stream for any FOV).
@@ -98,17 +114,40 @@ class LidarTracer {
     const Vec3 delta = Vec3(rr * std::cos(phi), rr * std::sin(phi), 0.0) - p;
     const double L = length(delta);
     if (!(L > 0.0) || !(p.z > 0.0)) return;
+    if (s_.fresnel) return next_event_fresnel(p, d, delta, path, w, acc);
     const Vec3 u = delta / L;
     const double cos_r = -u.z;  // angle between the arriving direction and the receiver's axis (-z)
     if (cos_r < cos_fov_) return;
     const double inside = L * (p.z - s_.distance) / p.z;  // the part of the return leg in the slab
     const double e = w * phase_eval(s_.phase, dot(d, u)) * std::exp(-sigma_t_ * inside) * cos_r / (L * L);
-    acc[slot_of(s_.time_edges, s_.n * (path + L))] += e;
+    acc[lidar_time_slot(s_.time_edges, s_.n * (path + L))] += e;
+  }
+
+  // The same through the Fresnel surface: the refracted path to y (fresnel.h), the water's phase function
+  // toward its lower leg, the surface's transmittance, the ray tube's spread instead of L^2 / cos; the FOV
+  // on the air leg; time z0 in the gap down, n times the water path, the air leg back.
+  void next_event_fresnel(const Vec3& p, const Vec3& d, const Vec3& delta, double path, double w,
+                          double* acc) const {
+    const double z0 = s_.distance, h = p.z - z0, rho = std::hypot(delta.x, delta.y);
+    if (!(h > 0.0)) return;
+    const RefractedPath rp = refracted_path(h, z0, rho, s_.n);
+    if (rp.cos_a < cos_fov_) return;
+    const double ux = rho > 0.0 ? delta.x / rho : 0.0, uy = rho > 0.0 ? delta.y / rho : 0.0;
+    const Vec3 u_w(ux * rp.a / rp.L_w, uy * rp.a / rp.L_w, -rp.cos_w);
+    const double T = 1.0 - fresnel_reflectance(rp.cos_w, 1.0 / s_.n);
+    const double e = w * phase_eval(s_.phase, dot(d, u_w)) * T * std::exp(-sigma_t_ * rp.L_w) / rp.spread;
+    acc[lidar_time_slot(s_.time_edges, z0 + s_.n * (path - z0 + rp.L_w) + rp.L_a)] += e;
   }
 
   // The analog tally: a photon leaving through the near face that crosses the gap into the disk within
   // the FOV.
-  void tally_analog(const Vec3& exit, const Vec3& d, double w, double* acc) const {
+  void tally_analog(const Vec3& exit, const Vec3& d_in, double w, double* acc) const {
+    Vec3 d = d_in;
+    if (s_.fresnel) {  // refracted into the air (the reflected part was sampled away by reflects())
+      const double sin2 = s_.n * s_.n * (1.0 - d.z * d.z);
+      if (sin2 >= 1.0) return;
+      d = Vec3(s_.n * d.x, s_.n * d.y, -std::sqrt(1.0 - sin2));
+    }
     const Vec3 at = exit + d * (exit.z / -d.z);  // where it meets the plane of the receiver
     if (s_.r_rx > 0.0 && std::hypot(at.x, at.y) < s_.r_rx && -d.z >= cos_fov_)
       acc[L_.analog()] += w / (kPi * s_.r_rx * s_.r_rx);
@@ -119,60 +158,59 @@ class LidarTracer {
   double sigma_t_, cos_fov_;
 };
 
-struct LidarBatches {
-  std::vector<std::vector<double>> sums;
-  std::vector<uint64_t> counts;
-};
-
-// Mean over all photons of f(batch sums), standard error from the spread of batch means.
-template <class F>
-Estimate batch_mean(const LidarBatches& b, uint64_t photons, F f) {
-  const int B = int(b.sums.size());
-  const double N = double(photons);
-  double total = 0.0;
-  for (int i = 0; i < B; ++i) total += f(b.sums[i]);
-  const double mean = total / N;
-  double var = 0.0;
-  for (int i = 0; i < B; ++i) {
-    const double fb = double(b.counts[i]) / N, xb = f(b.sums[i]) / double(b.counts[i]);
-    var += fb * fb * (xb - mean) * (xb - mean);
-  }
-  return Estimate{mean, std::sqrt(var * double(B) / double(B - 1))};
-}
-
 }  // namespace
+
+BatchTally run_photon_batches(uint64_t photons, int batches, uint64_t seed, size_t slots, size_t summed,
+                              const std::function<void(Rng&, double*)>& trace) {
+  const int B = batches;
+  std::vector<std::vector<double>> sums(B, std::vector<double>(slots, 0.0));
+  std::vector<uint64_t> first(B), counts(B);
+  for (int i = 0; i < B; ++i) {
+    counts[i] = photons / B + (uint64_t(i) < photons % B ? 1 : 0);
+    first[i] = i == 0 ? 0 : first[i - 1] + counts[i - 1];
+  }
+  tbb::parallel_for(tbb::blocked_range<int>(0, B, 1), [&](const tbb::blocked_range<int>& range) {
+    for (int i = range.begin(); i < range.end(); ++i)
+      for (uint64_t k = first[i]; k < first[i] + counts[i]; ++k) {
+        Rng rng(seed, k);
+        trace(rng, sums[i].data());
+      }
+  });
+  // Mean over all photons of f(batch sums), standard error from the spread of batch means.
+  const double N = double(photons);
+  auto batch_mean = [&](auto f) {
+    double total = 0.0;
+    for (int i = 0; i < B; ++i) total += f(sums[i]);
+    const double mean = total / N;
+    double var = 0.0;
+    for (int i = 0; i < B; ++i) {
+      const double fb = double(counts[i]) / N, xb = f(sums[i]) / double(counts[i]);
+      var += fb * fb * (xb - mean) * (xb - mean);
+    }
+    return Estimate{mean, std::sqrt(var * double(B) / double(B - 1))};
+  };
+  BatchTally r;
+  for (size_t j = 0; j < slots; ++j) r.slots.push_back(batch_mean([j](const auto& v) { return v[j]; }));
+  r.sum = batch_mean([&](const auto& v) {
+    double t = 0.0;
+    for (size_t j = 0; j < summed; ++j) t += v[j];
+    return t;
+  });
+  return r;
+}
 
 LidarMcResult run_lidar_mc(const LidarSettings& s) {
   validate_lidar(s, true);
   const LidarLayout L{s.time_edges.size() + 1};
-  const int B = s.batches;
-  LidarBatches b;
-  b.sums.assign(B, std::vector<double>(L.size(), 0.0));
-  std::vector<uint64_t> first(B);
-  b.counts.resize(B);
-  for (int i = 0; i < B; ++i) {
-    b.counts[i] = s.photons / B + (uint64_t(i) < s.photons % B ? 1 : 0);
-    first[i] = i == 0 ? 0 : first[i - 1] + b.counts[i - 1];
-  }
   const LidarTracer tracer(s, L);
-  tbb::parallel_for(tbb::blocked_range<int>(0, B, 1), [&](const tbb::blocked_range<int>& range) {
-    for (int i = range.begin(); i < range.end(); ++i)
-      for (uint64_t k = first[i]; k < first[i] + b.counts[i]; ++k) {
-        Rng rng(s.seed, k);
-        tracer.trace(rng, b.sums[i].data());
-      }
-  });
+  const BatchTally b = run_photon_batches(s.photons, s.batches, s.seed, L.size(), L.TS,
+                                          [&](Rng& rng, double* acc) { tracer.trace(rng, acc); });
   LidarMcResult r;
-  auto slot = [&](size_t j) { return batch_mean(b, s.photons, [j](const auto& v) { return v[j]; }); };
-  r.received.before = slot(0);
-  for (size_t j = 1; j + 1 < L.TS; ++j) r.received.bins.push_back(slot(j));
-  r.received.after = slot(L.TS - 1);
-  r.total = batch_mean(b, s.photons, [&](const auto& v) {
-    double t = 0.0;
-    for (size_t j = 0; j < L.TS; ++j) t += v[j];
-    return t;
-  });
-  r.analog = slot(L.analog());
+  r.received.before = b.slots[0];
+  for (size_t j = 1; j + 1 < L.TS; ++j) r.received.bins.push_back(b.slots[j]);
+  r.received.after = b.slots[L.TS - 1];
+  r.total = b.sum;
+  r.analog = b.slots[L.analog()];
   return r;
 }
 

@@ -10,6 +10,7 @@
 #include <sstream>
 #include <vector>
 
+#include "media/fournier_forand.h"
 #include "nimbus/error.h"
 
 namespace nimbus {
@@ -126,8 +127,26 @@ Phase parse_phase_spec(const std::string& spec) {
       throw Error(fmt::format("phase '{}': mie needs a table name of letters, digits, '_', '-', '.'", spec));
     return load_phase_table(args, phase_table_dir() + "/" + args + ".csv");
   }
+  if (kind == "ff") {
+    const auto v = parse_numbers(spec, args, 2);
+    if (!ff_parameters_valid(v[0], v[1]))
+      throw Error(fmt::format("phase '{}': Fournier-Forand needs n in (1, 1.5] and mu in (3, 5]", spec));
+    return make_ff_phase(v[0], v[1]);
+  }
+  if (kind == "ffb") {
+    const double b = parse_numbers(spec, args, 1)[0];
+    double mu = 0.0;
+    try {
+      mu = ff_mobley_mu(b);
+    } catch (const Error& e) {
+      throw Error(fmt::format("phase '{}': {}", spec, e.what()));
+    }
+    return make_ff_phase(ff_mobley_n(mu), mu);
+  }
   throw Error(fmt::format(
-      "phase '{}': unknown type (use iso, hg:G, dhg:G1,G2,W, gauss:THETA2, mie:NAME or mie:FILE.csv)", spec));
+      "phase '{}': unknown type (use iso, hg:G, dhg:G1,G2,W, gauss:THETA2, mie:NAME, mie:FILE.csv, "
+      "ff:N,MU or ffb:B)",
+      spec));
 }
 
 }  // namespace nimbus

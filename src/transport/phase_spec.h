@@ -1,6 +1,8 @@
 // Phase functions from short command-line specs: `iso`, `hg:G`, `dhg:G1,G2,W`, `gauss:THETA2`,
 // `mie:NAME` (the table phase/NAME.csv under $NIMBUS_DATA_DIR, else under the installed share/nimbus,
-// else data/phase/NAME.csv of the source tree) or `mie:PATH` (a path with '/' or ending in .csv: that file).
+// else data/phase/NAME.csv of the source tree) or `mie:PATH` (a path with '/' or ending in .csv: that file),
+// `ff:N,MU` (Fournier-Forand, refractive index N, Junge slope MU) or `ffb:B` (Fournier-Forand with the
+// backscatter fraction B on Mobley et al. 2002's curve n = 1.01 + 0.1542 (mu - 3)); media/fournier_forand.h.
 #pragma once
 
 #include <string>

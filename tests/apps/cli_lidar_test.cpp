@@ -101,6 +101,9 @@ TEST(CliLidar, BadMediumOrModelsExitTwoAndTheOutputIsCheckedFirst) {
   expect_refused({
       {"--fov 0.01 --mu-a 0.1 --time-edges 1,2", "--albedo"},
       {"--fov 0.01 --models mc,foo --time-edges 1,2", "--models"},
+      {"--fov 0.01 --time-edges 1,2 --surface glass", "--surface"},
+      {"--fov 0.01 --time-edges 1,2 --surface fresnel", "--distance"},
+      {"--fov 0.01 --time-edges 1,2 --surface fresnel --distance 1 --models mfs", "--models"},
   });
   // The output path is checked before any work (a billion photons would take hours).
   const CliRun r = run_cli(
@@ -108,6 +111,81 @@ TEST(CliLidar, BadMediumOrModelsExitTwoAndTheOutputIsCheckedFirst) {
       "/nonexistent/dir/x.csv");
   EXPECT_EQ(r.rc, 2) << r.out;
   EXPECT_NE(r.out.find("--output"), std::string::npos) << r.out;
+}
+
+// A wide box as a scene (the lidar ignores the camera and the light).
+std::filesystem::path box_scene(const std::string& name, const std::string& sigma_s) {
+  const auto file = temp_dir() / name;
+  std::ofstream(file) << R"({"camera": {"position": [0, -5, 0], "look_at": [0, 0, 0], "up": [0, 0, 1],
+      "fov_y_deg": 30, "width": 8, "height": 8},
+    "media": [{"shape": {"type": "box", "min": [-50, -50, 1], "max": [50, 50, 3]}, "sigma_s": )"
+                      << sigma_s
+                      << R"(, "sigma_a": 0.1, "phase": {"type": "fournier_forand", "n": 1.1, "mu": 3.5835}}],
+    "lights": [{"type": "directional", "direction": [0, 0, -1], "irradiance": 1}]})";
+  return file;
+}
+
+TEST(CliLidar, SceneWritesMcAndSingleRows) {
+  const auto out = temp_dir() / "scene_lidar.csv";
+  const CliRun r = run_cli("lidar --scene " + box_scene("box.json", "1").string() +
+                           " --origin 0,0,0 --dir 0,0,2 --fov 0.05 --receiver-radius 0.1 --photons 4000 "
+                           "--time-edges 2:6:8 --models mc,single -o " +
+                           out.string());
+  ASSERT_EQ(r.rc, 0) << r.out;
+  std::ifstream in(out);
+  std::string line;
+  std::getline(in, line);
+  EXPECT_EQ(line, "model,tlo,thi,value,stderr,bin_unit,value_unit");
+  std::map<std::string, std::vector<std::vector<std::string>>> rows;
+  while (std::getline(in, line)) rows[split(line)[0]].push_back(split(line));
+  ASSERT_EQ(rows["mc"].size(), 10u);  // 0..2, eight bins, 6..inf
+  ASSERT_EQ(rows["single"].size(), 8u);
+  EXPECT_EQ(std::stod(rows["mc"].front()[3]), 0.0);  // nothing before 2 x the clear gap
+  for (int i = 0; i < 8; ++i) EXPECT_GT(std::stod(rows["single"][i][3]), 0.0);
+}
+
+TEST(CliLidar, BadSceneInputExitsTwoNamingFileAndField) {
+  const auto out = temp_dir() / "bad_scene.csv";
+  const std::string good = box_scene("good.json", "1").string(), bad = box_scene("bad.json", "-1").string();
+  const std::string tail = " --fov 0.05 --time-edges 2:6:8 --photons 100 -o " + out.string();
+  const std::vector<std::pair<std::string, std::vector<std::string>>> cases = {
+      {"--scene " + bad, {"bad.json", "/media/0/sigma_s"}},
+      {"--scene " + (temp_dir() / "missing.json").string(), {"missing.json"}},
+      {"--scene " + good + " --mu-s 1", {"--mu-s"}},
+      {"--scene " + good + " --models mfs", {"--models"}},
+      {"--scene " + good + " --dir 0,0,0", {"--dir"}},
+      {"--scene " + good + " --dir 1,2", {"--dir"}},
+      {"--scene " + good + " --origin 1,2,x", {"--origin"}},
+      {"--scene " + good + " --channel 3", {"--channel"}},
+      {"--scene " + good + " --surface fresnel", {"--surface"}},
+      {"--mu-s 1 --albedo 0.9 --g 0.9 --thickness 2 --origin 1,1,1", {"--origin"}},
+      {"--albedo 0.9 --g 0.9 --thickness 2", {"--mu-s"}},
+  };
+  for (const auto& [args, named] : cases) {
+    const CliRun r = run_cli("lidar " + args + tail);
+    EXPECT_EQ(r.rc, 2) << args << "\n" << r.out;
+    for (const std::string& n : named) EXPECT_NE(r.out.find(n), std::string::npos) << args << "\n" << r.out;
+    EXPECT_FALSE(std::filesystem::exists(out)) << args;
+  }
+}
+
+TEST(CliLidar, FresnelSurfaceRowAndDefaultModels) {
+  const auto out = temp_dir() / "fresnel.csv";
+  const CliRun r = run_cli(
+      "lidar --mu-s 1 --albedo 0.9 --g 0.9 --thickness 2 --distance 1 --n 1.33 --surface fresnel --fov 0.05 "
+      "--receiver-radius 0.1 --photons 2000 --time-edges 2:6:4 -o " +
+      out.string());
+  ASSERT_EQ(r.rc, 0) << r.out;
+  std::ifstream in(out);
+  std::string line;
+  std::map<std::string, std::vector<std::vector<std::string>>> rows;
+  while (std::getline(in, line)) rows[split(line)[0]].push_back(split(line));
+  EXPECT_EQ(rows["mc"].size(), 6u);  // 0..2, four bins, 6..inf
+  EXPECT_EQ(rows["single"].size(), 4u);
+  EXPECT_EQ(rows["mfs"].size(), 0u);
+  ASSERT_EQ(rows["surface"].size(), 1u);
+  EXPECT_EQ(rows["surface"][0][1], "2");  // at twice the gap
+  EXPECT_NEAR(std::stod(rows["surface"][0][3]), std::pow(0.33 / 2.33, 2) / (M_PI * 0.01), 1e-7);
 }
 
 }  // namespace

@@ -80,7 +80,7 @@ TEST(Scene, BadInputCatalogue) {
       {"/media/0/phase/g", -1.5, false, "scene.json: /media/0/phase/g: must satisfy |g| < 1"},
       {"/media/0/phase/type", "rayleigh", false,
        "scene.json: /media/0/phase/type: unknown phase function 'rayleigh' (known: isotropic, hg, double_hg, "
-       "gauss)"},
+       "gauss, fournier_forand)"},
       {"/media/0/shape/radius", 0.0, false, "scene.json: /media/0/shape/radius: must be > 0"},
       {"/media/0/shape/type", "torus", false,
        "scene.json: /media/0/shape/type: unknown shape 'torus' (known: sphere, box, vdb, cloud)"},
