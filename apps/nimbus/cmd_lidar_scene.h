@@ -1,6 +1,5 @@
-// nimbus lidar --scene: the lidar looking into a scene's media (src/integrators/lidar_scene.h). Kept apart
-// from cmd_lidar.cpp, which parses the options: nimbus/scene.h and transport/time_resolved.h each define
-// kMaxTimeBins.
+// nimbus lidar --scene: the lidar looking into a scene's media (src/integrators/lidar_scene.h), apart from
+// cmd_lidar.cpp, which parses the options and runs the slab lidar.
 #pragma once
 
 #include <cstdint>

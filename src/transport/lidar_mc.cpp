@@ -26,7 +26,7 @@ void validate_lidar(const LidarSettings& s, bool monte_carlo) {
   if (!(s.r_rx >= 0.0) || !std::isfinite(s.r_rx)) bad("receiver radius must be finite and >= 0");
   if (!(s.fov > 0.0) || !(s.fov < 0.5 * kPi)) bad("fov (half-angle) must lie in (0, pi/2)");
   if (s.time_edges.size() < 2) bad("time edges need at least two values");
-  if (s.time_edges.size() - 1 > kMaxTimeBins) bad(fmt::format("at most {} time bins", kMaxTimeBins));
+  if (s.time_edges.size() - 1 > kMaxTimeEdgeBins) bad(fmt::format("at most {} time bins", kMaxTimeEdgeBins));
   for (size_t i = 0; i < s.time_edges.size(); ++i) {
     if (!(s.time_edges[i] >= 0.0) || !std::isfinite(s.time_edges[i]))
       bad("time edges must be finite and >= 0");

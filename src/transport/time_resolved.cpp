@@ -25,15 +25,15 @@ std::vector<double> parse_time_edges(const std::string& what, const std::string&
     const double n = v[2];
     if (!(n >= 1.0) || n != std::floor(n))
       throw Error(fmt::format("{}: N must be a whole number >= 1", what));
-    if (n > double(kMaxTimeBins))
-      throw Error(fmt::format("{}: {} bins is more than the {} allowed", what, n, kMaxTimeBins));
+    if (n > double(kMaxTimeEdgeBins))
+      throw Error(fmt::format("{}: {} bins is more than the {} allowed", what, n, kMaxTimeEdgeBins));
     for (size_t i = 0; i <= size_t(n); ++i) e.push_back(v[0] + (v[1] - v[0]) * double(i) / n);
   } else {
     e = parse_number_list(what, spec);
   }
   if (e.size() < 2) throw Error(fmt::format("{}: needs at least two edges (one bin)", what));
-  if (e.size() - 1 > kMaxTimeBins)
-    throw Error(fmt::format("{}: {} bins is more than the {} allowed", what, e.size() - 1, kMaxTimeBins));
+  if (e.size() - 1 > kMaxTimeEdgeBins)
+    throw Error(fmt::format("{}: {} bins is more than the {} allowed", what, e.size() - 1, kMaxTimeEdgeBins));
   for (size_t i = 0; i < e.size(); ++i) {
     if (!(e[i] >= 0.0)) throw Error(fmt::format("{}: negative time {}", what, e[i]));
     if (i > 0 && !(e[i] > e[i - 1]))

@@ -8,11 +8,12 @@
 
 namespace nimbus {
 
-// The most time bins one run may ask for (each costs a tally per batch, per plane and per face).
-inline constexpr size_t kMaxTimeBins = 100000;
+// The most time bins one run of beam, slab or lidar may ask for (each costs a tally per batch, per plane
+// and per face); the same number as a render's kMaxTimeBins (nimbus/scene.h).
+inline constexpr size_t kMaxTimeEdgeBins = 100000;
 
 // Time-bin edges from `t0,t1,...` (at least two, strictly increasing) or `lo:hi:N` (N equal bins from lo
-// to hi).  Edges must be finite and >= 0, at most kMaxTimeBins bins.  Errors name `what`.
+// to hi).  Edges must be finite and >= 0, at most kMaxTimeEdgeBins bins.  Errors name `what`.
 std::vector<double> parse_time_edges(const std::string& what, const std::string& spec);
 
 // --- Diffusion: time-resolved diffuse reflectance of a semi-infinite medium -------------------------

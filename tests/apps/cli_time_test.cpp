@@ -134,8 +134,11 @@ TEST(CliTime, BeamJointTablesSumToTheDelayRows) {
       EXPECT_EQ(rows[i][2], q);
       sum[rows[i][0] + ":" + rows[i][1] + ":" + rows[i][3]] += std::stod(rows[i][7]);
     }
-    for (const auto& [key, v] : delay)  // the same tallies, to the 9 digits printed
-      if (key.rfind("mc:", 0) == 0) EXPECT_NEAR(sum[key], v, 1e-8 * v + 1e-15) << q << " " << key;
+    for (const auto& [key, v] : delay) {  // the same tallies, to the 9 digits printed
+      if (key.rfind("mc:", 0) == 0) {
+        EXPECT_NEAR(sum[key], v, 1e-8 * v + 1e-15) << q << " " << key;
+      }
+    }
   }
   std::filesystem::remove_all(dir);
 }
