@@ -13,7 +13,11 @@ namespace {
 
 constexpr int kFloats = 9;  // per node: traced (rgb), traced x mean cosine (rgb), straight (rgb)
 constexpr double kR2a1 = 0.75487766624669276, kR2a2 = 0.56984029099805327;  // the R2 sequence
-constexpr double kRoulette = 0.05;  // roulette below this ratio of weight to T_wide
+constexpr double kRoulette = 0.05;
+// Deposit samples (and the loss's midpoint rule) at most this many node spacings apart: 0.5 (0.25
+// before) halves the deposits and density lookups with no change in the validation errors beyond their
+// seed-to-seed spread (docs/benchmarks.md, issue 12).
+constexpr double kDepositStep = 0.5;  // roulette below this ratio of weight to T_wide
 
 // Adds v (channel ch) with trilinear weights st to the tally: to the straight column, or to the traced
 // one and (times mu) the traced x cosine one.
@@ -72,7 +76,7 @@ Rgb BeamPhotons::deposit(std::vector<float>& tally, const Vec3& x, const Vec3& w
   double t0, t1;
   if (!grid.bounds.intersect(x, w, 0.0, t_end, &t0, &t1) || !(t1 - t0 > 0.0)) return weight;
   const double len = t1 - t0;
-  const int n = std::max(1, int(std::ceil(len / (0.25 * grid.min_spacing()))));
+  const int n = std::max(1, int(std::ceil(len / (kDepositStep * grid.min_spacing()))));
   const double dl = len / n;
   for (int k = 0; k < n; ++k) {
     const Vec3 q = x + w * (t0 + (k + 0.5) * dl);

@@ -91,8 +91,11 @@ MfsIntegrator::MfsIntegrator(const SceneContext& context, MfsSettings settings, 
   constexpr double map_step = 0.25;
   for (const Light& l : ctx_.lights) {
     const int res = is_area_light(l) ? 8 : s_.shadow_map_resolution;  // area lights: a token map (light_beam)
-    full_maps_.emplace_back(ctx_.media, ctx_.majorants, l, res, map_step);
-    if (s_.forward_light_path()) reduced_maps_.emplace_back(ctx_.media, ctx_.majorants, l, res, map_step, f_);
+    if (s_.forward_light_path())
+      TransmittanceGrid::build_pair(ctx_.media, ctx_.majorants, l, res, map_step, f_,
+                                    &full_maps_.emplace_back(), &reduced_maps_.emplace_back());
+    else
+      full_maps_.emplace_back(ctx_.media, ctx_.majorants, l, res, map_step);
   }
   if (!s_.scatter_grid_resolution) {
     // "auto": cells of at most ~1.6 optical depths at the medium's typical extinction (the mean of the

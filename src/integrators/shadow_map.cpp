@@ -27,9 +27,9 @@ Rgb marched_transmittance(const SceneMedia& media, const MajorantGrid& grid, con
   return exp(-tau);
 }
 
-TransmittanceGrid::TransmittanceGrid(const SceneMedia& media, const MajorantGrid& grid, const Light& light,
-                                     int resolution, double tau_step,
-                                     const std::vector<double>& peak_fraction) {
+template <typename OneNode>
+void TransmittanceGrid::fill(const MajorantGrid& grid, int resolution, TransmittanceGrid* second,
+                             OneNode&& one_node) {
   Bounds bounds = grid.bounds();
   if (bounds.empty()) {
     bounds.lo = Vec3(0.0);
@@ -37,21 +37,56 @@ TransmittanceGrid::TransmittanceGrid(const SceneMedia& media, const MajorantGrid
   }
   grid_ = node_grid_spanning(bounds, resolution);
   values_.assign(grid_.size() * 3, 1.0f);
+  if (second) second->grid_ = grid_, second->values_.assign(grid_.size() * 3, 1.0f);
   tbb::parallel_for(0, grid_.nodes[2], [&](int z) {
     for (int y = 0; y < grid_.nodes[1]; ++y) {
       for (int x = 0; x < grid_.nodes[0]; ++x) {
-        const Vec3 p = grid_.position(x, y, z);
-        Rgb T(1.0);
-        // The centre of the light (a sun disc is treated as its centre direction here; a spot's map
-        // covers its whole sphere of directions, the cone is applied by sample_light).
-        Vec3 wi;
-        double distance = 0.0;
-        if (light_centre(light, p, &wi, &distance))
-          T = marched_transmittance(media, grid, p, wi, distance, tau_step, peak_fraction);
-        float* v = &values_[grid_.index(x, y, z) * 3];
-        for (int c = 0; c < 3; ++c) v[c] = float(T[c]);
+        Rgb T(1.0), T2(1.0);
+        one_node(grid_.position(x, y, z), &T, second ? &T2 : nullptr);
+        const size_t i = grid_.index(x, y, z) * 3;
+        for (int c = 0; c < 3; ++c) values_[i + c] = float(T[c]);
+        if (second)
+          for (int c = 0; c < 3; ++c) second->values_[i + c] = float(T2[c]);
       }
     }
+  });
+}
+
+TransmittanceGrid::TransmittanceGrid(const SceneMedia& media, const MajorantGrid& grid, const Light& light,
+                                     int resolution, double tau_step,
+                                     const std::vector<double>& peak_fraction) {
+  fill(grid, resolution, nullptr, [&](const Vec3& p, Rgb* T, Rgb*) {
+    // The centre of the light (a sun disc is treated as its centre direction here; a spot's map
+    // covers its whole sphere of directions, the cone is applied by sample_light).
+    Vec3 wi;
+    double distance = 0.0;
+    if (light_centre(light, p, &wi, &distance))
+      *T = marched_transmittance(media, grid, p, wi, distance, tau_step, peak_fraction);
+  });
+}
+
+void TransmittanceGrid::build_pair(const SceneMedia& media, const MajorantGrid& grid, const Light& light,
+                                   int resolution, double tau_step, const std::vector<double>& peak_fraction,
+                                   TransmittanceGrid* full, TransmittanceGrid* reduced) {
+  full->fill(grid, resolution, reduced, [&](const Vec3& p, Rgb* T_full, Rgb* T_reduced) {
+    Vec3 wi;
+    double distance = 0.0;
+    if (!light_centre(light, p, &wi, &distance)) return;
+    // Each sum stops after the step that takes it to 50 (as marched_transmittance alone does).
+    Rgb tau(0.0), tau_reduced(0.0);
+    bool full_done = false;
+    MediumPoint mp;
+    march(grid, p, wi, distance, tau_step, 0.5, [&](const Vec3& x, double, double dt) {
+      media.eval(x, &mp);
+      Rgb s = mp.sigma_t();
+      if (!full_done) tau += s * dt, full_done = min_component(tau) >= 50.0;
+      for (int i = 0; i < mp.count && i < int(peak_fraction.size()); ++i)
+        s -= mp.sigma_s_i[i] * peak_fraction[i];
+      tau_reduced += s * dt;
+      return !full_done || min_component(tau_reduced) < 50.0;
+    });
+    *T_full = exp(-tau);
+    *T_reduced = exp(-tau_reduced);
   });
 }
 

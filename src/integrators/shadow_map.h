@@ -31,10 +31,22 @@ class TransmittanceGrid {
   // peak_fraction: see reduced_sigma_t (empty: plain extinction).
   TransmittanceGrid(const SceneMedia& media, const MajorantGrid& grid, const Light& light, int resolution,
                     double tau_step, const std::vector<double>& peak_fraction = {});
+  TransmittanceGrid() = default;  // empty (every lookup 0) until build_pair fills it
+  // A light's map of the plain extinction and its map of the reduced one (peak_fraction) from one march
+  // per node: the march's steps depend on the majorant grid only, so both see the same points and each
+  // equals the map built alone (one density lookup per step instead of two).
+  static void build_pair(const SceneMedia& media, const MajorantGrid& grid, const Light& light,
+                         int resolution, double tau_step, const std::vector<double>& peak_fraction,
+                         TransmittanceGrid* full, TransmittanceGrid* reduced);
   Rgb lookup(const Vec3& p) const;
   size_t memory_bytes() const { return values_.size() * sizeof(float); }
 
  private:
+  // The node grid on the media's bounds; fills every node with one_node(position, T, T2) (T2 may be
+  // null) into values_ (and second->values_ when given).
+  template <typename OneNode>
+  void fill(const MajorantGrid& grid, int resolution, TransmittanceGrid* second, OneNode&& one_node);
+
   NodeGrid grid_;              // nodes on the media's bounds (node_grid_spanning)
   std::vector<float> values_;  // rgb per node
 };

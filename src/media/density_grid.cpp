@@ -7,6 +7,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cstring>
 #include <vector>
@@ -273,6 +274,8 @@ DensityGrid DensityGrid::from_nanovdb(nanovdb::GridHandle<nanovdb::HostBuffer> h
 
   DensityGrid g;
   g.grid_ = grid;
+  static std::atomic<uint64_t> next_id{1};
+  g.id_ = next_id.fetch_add(1);
   int hi_i[3];
   for (int a = 0; a < 3; ++a) {
     g.lo_i_[a] = w.bbox.min()[a] - 1;

@@ -17,6 +17,7 @@
 #include <cstdint>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "core/math.h"
@@ -75,10 +76,21 @@ class DensityGrid {
   Vec3 index_to_world(const Vec3& index) const;
 
   // Trilinear density at an index-space position (negative voxels clamped to 0); 0 outside
-  // [index_lo(), index_hi()]. Thread-safe: creates an accessor per call (use Sampler in hot loops).
+  // [index_lo(), index_hi()]. Thread-safe: each thread keeps one accessor for the grid it read last
+  // (keyed by the grid's process-unique id, not its address), so lookups near the previous one skip the
+  // descent from the root (the photons' tracking and the shadow maps' marches: issue 12). The values
+  // are the same as with a fresh accessor.
   double density_index(const Vec3& index_pos) const {
-    auto acc = grid_->getAccessor();
-    return trilinear(acc, index_pos);
+    struct Cache {
+      uint64_t id = 0;
+      std::optional<nanovdb::DefaultReadAccessor<float>> acc;
+    };
+    thread_local Cache cache;
+    if (cache.id != id_) {
+      cache.acc.emplace(grid_->getAccessor());
+      cache.id = id_;
+    }
+    return trilinear(*cache.acc, index_pos);
   }
 
   // Conservative maximum of density_index over the index-space box [index_lo, index_hi] (corners in any
@@ -119,6 +131,7 @@ class DensityGrid {
   std::array<int, 3> lo_i_{};  // integer index_lo
   Vec3 lo_{0.0}, hi_{0.0};
   double max_density_ = 0.0;
+  uint64_t id_ = 0;  // unique per grid built in this process (copies share it): density_index's cache key
 };
 
 // ---- inline implementation -------------------------------------------------------------------

@@ -102,6 +102,35 @@ TEST(VdbLoad, CopiesShareAndOutliveTheOriginal) {
   EXPECT_EQ(&b.nano_grid(), &c.nano_grid());
 }
 
+// density_index keeps one accessor per thread for the grid it read last: reads that alternate between
+// grids, and a grid loaded after another was freed (which may reuse its memory), must give what a
+// fresh accessor (DensityGrid::Sampler) gives.
+TEST(VdbLoad, CachedAccessorFollowsTheGridRead) {
+  NIMBUS_REQUIRE_FILE(shared_volume(kSmoke));
+  NIMBUS_REQUIRE_FILE(shared_volume(kCloud));
+  std::mt19937_64 gen(11);
+  auto check = [&](const DensityGrid& a, const DensityGrid& b) {
+    DensityGrid::Sampler sa(a), sb(b);
+    int nonzero = 0;
+    for (int i = 0; i < 2000; ++i) {
+      const DensityGrid& g = i % 3 ? a : b;
+      DensityGrid::Sampler& s = i % 3 ? sa : sb;
+      Vec3 p;
+      for (int k = 0; k < 3; ++k)
+        p[k] = std::uniform_real_distribution<double>(g.index_lo()[k], g.index_hi()[k])(gen);
+      const double expected = s.density_index(p);
+      ASSERT_EQ(g.density_index(p), expected) << i;
+      nonzero += expected > 0.0;
+    }
+    EXPECT_GT(nonzero, 100);
+  };
+  for (int round = 0; round < 3; ++round) {
+    const DensityGrid smoke = load_density_grid(shared_volume(kSmoke));
+    const DensityGrid cloud = load_density_grid(shared_volume(round == 1 ? kSmoke : kCloud));
+    check(smoke, cloud);
+  }
+}
+
 // ---- sampling -----------------------------------------------------------------------------------
 
 class VdbSample : public ::testing::TestWithParam<const char*> {};
