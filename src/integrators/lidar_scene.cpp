@@ -2,8 +2,6 @@
 // next-event estimates through ratio tracking, and the single-scatter lidar equation along the axis.
 #include "integrators/lidar_scene.h"
 
-#include <fmt/format.h>
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -21,19 +19,8 @@ void validate_scene_lidar(const SceneLidarSettings& s, bool monte_carlo) {
     if (!std::isfinite(s.origin[a]) || !std::isfinite(s.dir[a])) bad("origin and dir must be finite");
   if (!(std::abs(length(s.dir) - 1.0) < 1e-9)) bad("dir must be a unit vector");
   if (s.channel < 0 || s.channel > 2) bad("channel must be 0, 1 or 2");
-  if (!(s.n >= 1.0) || !(s.n <= 10.0)) bad("n must lie in [1, 10]");
-  if (!(s.r_rx >= 0.0) || !std::isfinite(s.r_rx)) bad("receiver radius must be finite and >= 0");
-  if (!(s.fov > 0.0) || !(s.fov < 0.5 * kPi)) bad("fov (half-angle) must lie in (0, pi/2)");
-  if (s.time_edges.size() < 2) bad("time edges need at least two values");
-  if (s.time_edges.size() - 1 > size_t(kMaxTimeBins)) bad(fmt::format("at most {} time bins", kMaxTimeBins));
-  for (size_t i = 0; i < s.time_edges.size(); ++i) {
-    if (!(s.time_edges[i] >= 0.0) || !std::isfinite(s.time_edges[i]))
-      bad("time edges must be finite and >= 0");
-    if (i > 0 && !(s.time_edges[i] > s.time_edges[i - 1])) bad("time edges must increase");
-  }
-  if (!monte_carlo) return;
-  if (s.batches < 2) bad("needs at least 2 batches");
-  if (s.photons < uint64_t(s.batches)) bad("needs at least one photon per batch");
+  validate_lidar_receiver(s.n, s.r_rx, s.fov, s.time_edges);
+  if (monte_carlo) validate_lidar_batches(s.photons, s.batches);
 }
 
 namespace {

@@ -59,6 +59,10 @@ struct LidarMcResult {
 
 // Throws nimbus::Error naming the setting on invalid input.
 void validate_lidar(const LidarSettings& s, bool monte_carlo);
+// The checks both lidars (slab and scene) share, with the same messages: refractive index, receiver
+// radius and field of view, time edges; and the Monte Carlo's photons and batches.
+void validate_lidar_receiver(double n, double r_rx, double fov, const std::vector<double>& time_edges);
+void validate_lidar_batches(uint64_t photons, int batches);
 
 // Deterministic for a seed, whatever the number of threads (photon i draws from Rng(seed, i)).
 LidarMcResult run_lidar_mc(const LidarSettings& s);

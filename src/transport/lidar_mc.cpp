@@ -15,6 +15,24 @@
 
 namespace nimbus {
 
+void validate_lidar_receiver(double n, double r_rx, double fov, const std::vector<double>& time_edges) {
+  auto bad = [](const std::string& m) { throw Error("lidar: " + m); };
+  if (!(n >= 1.0) || !(n <= 10.0)) bad("n must lie in [1, 10]");
+  if (!(r_rx >= 0.0) || !std::isfinite(r_rx)) bad("receiver radius must be finite and >= 0");
+  if (!(fov > 0.0) || !(fov < 0.5 * kPi)) bad("fov (half-angle) must lie in (0, pi/2)");
+  if (time_edges.size() < 2) bad("time edges need at least two values");
+  if (time_edges.size() - 1 > kMaxTimeEdgeBins) bad(fmt::format("at most {} time bins", kMaxTimeEdgeBins));
+  for (size_t i = 0; i < time_edges.size(); ++i) {
+    if (!(time_edges[i] >= 0.0) || !std::isfinite(time_edges[i])) bad("time edges must be finite and >= 0");
+    if (i > 0 && !(time_edges[i] > time_edges[i - 1])) bad("time edges must increase");
+  }
+}
+
+void validate_lidar_batches(uint64_t photons, int batches) {
+  if (batches < 2) throw Error("lidar: needs at least 2 batches");
+  if (photons < uint64_t(batches)) throw Error("lidar: needs at least one photon per batch");
+}
+
 void validate_lidar(const LidarSettings& s, bool monte_carlo) {
   auto bad = [](const std::string& m) { throw Error("lidar: " + m); };
   if (!(s.sigma_s >= 0.0) || !std::isfinite(s.sigma_s)) bad("sigma_s must be finite and >= 0");
@@ -22,20 +40,9 @@ void validate_lidar(const LidarSettings& s, bool monte_carlo) {
   if (!std::isfinite(s.sigma_s + s.sigma_a)) bad("sigma_s + sigma_a must be finite");
   if (!(s.thickness > 0.0) || !std::isfinite(s.thickness)) bad("thickness must be finite and > 0");
   if (!(s.distance >= 0.0) || !std::isfinite(s.distance)) bad("distance must be finite and >= 0");
-  if (!(s.n >= 1.0) || !(s.n <= 10.0)) bad("n must lie in [1, 10]");
-  if (!(s.r_rx >= 0.0) || !std::isfinite(s.r_rx)) bad("receiver radius must be finite and >= 0");
-  if (!(s.fov > 0.0) || !(s.fov < 0.5 * kPi)) bad("fov (half-angle) must lie in (0, pi/2)");
-  if (s.time_edges.size() < 2) bad("time edges need at least two values");
-  if (s.time_edges.size() - 1 > kMaxTimeEdgeBins) bad(fmt::format("at most {} time bins", kMaxTimeEdgeBins));
-  for (size_t i = 0; i < s.time_edges.size(); ++i) {
-    if (!(s.time_edges[i] >= 0.0) || !std::isfinite(s.time_edges[i]))
-      bad("time edges must be finite and >= 0");
-    if (i > 0 && !(s.time_edges[i] > s.time_edges[i - 1])) bad("time edges must increase");
-  }
+  validate_lidar_receiver(s.n, s.r_rx, s.fov, s.time_edges);
   if (s.fresnel && !(s.distance > 0.0)) bad("a Fresnel surface needs a gap (distance > 0)");
-  if (!monte_carlo) return;
-  if (s.batches < 2) bad("needs at least 2 batches");
-  if (s.photons < uint64_t(s.batches)) bad("needs at least one photon per batch");
+  if (monte_carlo) validate_lidar_batches(s.photons, s.batches);
 }
 
 size_t lidar_time_slot(const std::vector<double>& edges, double t) {
