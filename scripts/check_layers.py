@@ -14,7 +14,7 @@
     scripts/check_layers.py [--graph]    # --graph: print the folder graph as edges "a -> b (n includes)"
 Exit status 1 with one line per violation.
 """
-import os, re, sys
+import glob, os, re, sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 ORDER = ["api", "core", "media", "transport", "scene", "integrators", "io", "render", "apps"]
@@ -134,6 +134,41 @@ def long_functions(path, lines):
     return found
 
 
+# The test suites are unity builds (eight files to a translation unit), so two test files must not define
+# the same name at namespace scope: helpers shared by several files go to tests/support/, the others get
+# a name of their own. A line-based look at definitions that start in column 0.
+TEST_DEFINITION = [
+    re.compile(r"^(?:static\s+|inline\s+|constexpr\s+|const\s+)*[\w:<>,\s&*\[\]]+?[\s&*](\w+)\s*\([^;]*$"),
+    re.compile(r"^(?:struct|class|enum(?:\s+class)?)\s+(\w+)\s*[{:]"),
+    re.compile(r"^(?:static\s+)?(?:constexpr|const)\s+[\w:<>]+\s+(\w+)\s*(?:=|\[|\{)"),
+    re.compile(r"^using\s+(\w+)\s*="),
+    re.compile(r"^#define\s+(\w+)"),
+]
+
+
+def test_name_clashes():
+    bad = []
+    for suffix in ("_test.cpp", "_slowtest.cpp"):
+        where = {}
+        for path in sorted(glob.glob(os.path.join(ROOT, "tests", "**", "*" + suffix), recursive=True)):
+            rel = os.path.relpath(path, ROOT)
+            with open(path, encoding="utf-8") as f:
+                for n, line in enumerate(f, 1):
+                    if line.startswith(("TEST", " ", "}", "//", "namespace", "return")):
+                        continue
+                    for pattern in TEST_DEFINITION:
+                        m = pattern.match(line)
+                        if m and m.group(1) not in ("main", "if", "for", "while", "switch"):
+                            where.setdefault(m.group(1), []).append(f"{rel}:{n}")
+                            break
+        for name, places in sorted(where.items()):
+            files = {p.rsplit(":", 1)[0] for p in places}
+            if len(files) > 1:
+                bad.append(f"{name} is defined at namespace scope in {len(files)} test files ({', '.join(places)}): "
+                           "the unity build compiles them together; share it in tests/support/ or rename it")
+    return bad
+
+
 def main():
     edges, bad = {}, []
     for path in sources():
@@ -159,6 +194,7 @@ def main():
                 if f"long-function: {name.split('::')[-1]}" not in head and f"long-function: {name}" not in head:
                     bad.append(f"{rel}:{start}: {name} is {length} lines (over {MAX_FUNCTION_LINES}, and no "
                                f"'long-function: {name.split('::')[-1]}' reason at the file's top)")
+    bad += test_name_clashes()
     cycle = find_cycle(edges)
     if cycle:
         bad.append("include cycle between folders: " + " -> ".join(cycle))

@@ -21,14 +21,8 @@ namespace {
 using nimbus::test::CliRun;
 using nimbus::test::run_cli;
 
-std::filesystem::path temp_dir() {
-  auto d = std::filesystem::temp_directory_path() / ("nimbus_cli_test_" + std::to_string(::getpid()));
-  std::filesystem::create_directories(d);
-  return d;
-}
-
 TEST(CliBeam, WritesTheDocumentedCsv) {
-  const auto dir = temp_dir();
+  const auto dir = nimbus::test::cli_temp_dir("cli_test");
   const auto out = dir / "beam.csv";
   const CliRun r = run_cli(
       "beam --phase hg:0.9 --albedo 0.99 --depths 1,3 --photons 2000 --theta-edges 0,0.01,0.1,1,3.14159 "
@@ -143,7 +137,7 @@ TEST(CliSlab, TakesEveryPhaseFunctionBeamTakes) {
   ASSERT_EQ(g.rc, 0) << g.out;
   EXPECT_EQ(g.out, hg.out);
   // The other kinds run and conserve energy; a table by path (mie:FILE.csv) as well as by name.
-  const auto table = temp_dir() / "my_mie.csv";
+  const auto table = nimbus::test::cli_temp_dir("cli_test") / "my_mie.csv";
   std::filesystem::copy_file(
       std::filesystem::path(NIMBUS_SOURCE_DIR) / "data" / "phase" / "cloud_mie_550nm.csv", table,
       std::filesystem::copy_options::overwrite_existing);

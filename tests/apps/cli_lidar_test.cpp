@@ -19,26 +19,12 @@ namespace {
 using nimbus::test::CliRun;
 using nimbus::test::run_cli;
 
-std::filesystem::path temp_dir() {
-  auto d = std::filesystem::temp_directory_path() / ("nimbus_cli_lidar_test_" + std::to_string(::getpid()));
-  std::filesystem::create_directories(d);
-  return d;
-}
-
-std::vector<std::string> split(const std::string& line) {
-  std::vector<std::string> v;
-  std::stringstream ss(line);
-  std::string item;
-  while (std::getline(ss, item, ',')) v.push_back(item);
-  return v;
-}
-
 const std::string kArgs =
     "lidar --mu-s 1 --albedo 0.9 --phase hg:0.9 --thickness 2 --distance 1 --fov 0.05 --receiver-radius 0.1 "
     "--photons 20000 --time-edges 2:6:8";
 
 TEST(CliLidar, WritesTheCsvItPromises) {
-  const auto out = temp_dir() / "lidar.csv";
+  const auto out = nimbus::test::cli_temp_dir("cli_lidar_test") / "lidar.csv";
   const CliRun r = run_cli(kArgs + " -o " + out.string());
   ASSERT_EQ(r.rc, 0) << r.out;
   std::ifstream in(out);
@@ -47,7 +33,7 @@ TEST(CliLidar, WritesTheCsvItPromises) {
   EXPECT_EQ(line, "model,tlo,thi,value,stderr,bin_unit,value_unit");
   std::map<std::string, std::vector<std::vector<std::string>>> rows;
   while (std::getline(in, line)) {
-    const auto v = split(line);
+    const auto v = nimbus::test::split_csv(line);
     ASSERT_EQ(v.size(), 7u) << line;
     EXPECT_EQ(v[5], "length");
     EXPECT_EQ(v[6], "1/length^2 per photon");
@@ -69,7 +55,7 @@ TEST(CliLidar, WritesTheCsvItPromises) {
 
 // Each case exits 2, names `named` and writes nothing.
 void expect_refused(const std::vector<std::pair<std::string, std::string>>& cases) {
-  const auto out = temp_dir() / "bad.csv";
+  const auto out = nimbus::test::cli_temp_dir("cli_lidar_test") / "bad.csv";
   const std::string base =
       "lidar --mu-s 1 --albedo 0.9 --g 0.9 --thickness 2 --photons 100 -o " + out.string() + " ";
   for (const auto& [args, named] : cases) {
@@ -115,7 +101,7 @@ TEST(CliLidar, BadMediumOrModelsExitTwoAndTheOutputIsCheckedFirst) {
 
 // A wide box as a scene (the lidar ignores the camera and the light).
 std::filesystem::path box_scene(const std::string& name, const std::string& sigma_s) {
-  const auto file = temp_dir() / name;
+  const auto file = nimbus::test::cli_temp_dir("cli_lidar_test") / name;
   std::ofstream(file) << R"({"camera": {"position": [0, -5, 0], "look_at": [0, 0, 0], "up": [0, 0, 1],
       "fov_y_deg": 30, "width": 8, "height": 8},
     "media": [{"shape": {"type": "box", "min": [-50, -50, 1], "max": [50, 50, 3]}, "sigma_s": )"
@@ -126,7 +112,7 @@ std::filesystem::path box_scene(const std::string& name, const std::string& sigm
 }
 
 TEST(CliLidar, SceneWritesMcAndSingleRows) {
-  const auto out = temp_dir() / "scene_lidar.csv";
+  const auto out = nimbus::test::cli_temp_dir("cli_lidar_test") / "scene_lidar.csv";
   const CliRun r = run_cli("lidar --scene " + box_scene("box.json", "1").string() +
                            " --origin 0,0,0 --dir 0,0,2 --fov 0.05 --receiver-radius 0.1 --photons 4000 "
                            "--time-edges 2:6:8 --models mc,single -o " +
@@ -137,7 +123,8 @@ TEST(CliLidar, SceneWritesMcAndSingleRows) {
   std::getline(in, line);
   EXPECT_EQ(line, "model,tlo,thi,value,stderr,bin_unit,value_unit");
   std::map<std::string, std::vector<std::vector<std::string>>> rows;
-  while (std::getline(in, line)) rows[split(line)[0]].push_back(split(line));
+  while (std::getline(in, line))
+    rows[nimbus::test::split_csv(line)[0]].push_back(nimbus::test::split_csv(line));
   ASSERT_EQ(rows["mc"].size(), 10u);  // 0..2, eight bins, 6..inf
   ASSERT_EQ(rows["single"].size(), 8u);
   EXPECT_EQ(std::stod(rows["mc"].front()[3]), 0.0);  // nothing before 2 x the clear gap
@@ -145,12 +132,13 @@ TEST(CliLidar, SceneWritesMcAndSingleRows) {
 }
 
 TEST(CliLidar, BadSceneInputExitsTwoNamingFileAndField) {
-  const auto out = temp_dir() / "bad_scene.csv";
+  const auto out = nimbus::test::cli_temp_dir("cli_lidar_test") / "bad_scene.csv";
   const std::string good = box_scene("good.json", "1").string(), bad = box_scene("bad.json", "-1").string();
   const std::string tail = " --fov 0.05 --time-edges 2:6:8 --photons 100 -o " + out.string();
   const std::vector<std::pair<std::string, std::vector<std::string>>> cases = {
       {"--scene " + bad, {"bad.json", "/media/0/sigma_s"}},
-      {"--scene " + (temp_dir() / "missing.json").string(), {"missing.json"}},
+      {"--scene " + (nimbus::test::cli_temp_dir("cli_lidar_test") / "missing.json").string(),
+       {"missing.json"}},
       {"--scene " + good + " --mu-s 1", {"--mu-s"}},
       {"--scene " + good + " --models mfs", {"--models"}},
       {"--scene " + good + " --dir 0,0,0", {"--dir"}},
@@ -170,7 +158,7 @@ TEST(CliLidar, BadSceneInputExitsTwoNamingFileAndField) {
 }
 
 TEST(CliLidar, FresnelSurfaceRowAndDefaultModels) {
-  const auto out = temp_dir() / "fresnel.csv";
+  const auto out = nimbus::test::cli_temp_dir("cli_lidar_test") / "fresnel.csv";
   const CliRun r = run_cli(
       "lidar --mu-s 1 --albedo 0.9 --g 0.9 --thickness 2 --distance 1 --n 1.33 --surface fresnel --fov 0.05 "
       "--receiver-radius 0.1 --photons 2000 --time-edges 2:6:4 -o " +
@@ -179,7 +167,8 @@ TEST(CliLidar, FresnelSurfaceRowAndDefaultModels) {
   std::ifstream in(out);
   std::string line;
   std::map<std::string, std::vector<std::vector<std::string>>> rows;
-  while (std::getline(in, line)) rows[split(line)[0]].push_back(split(line));
+  while (std::getline(in, line))
+    rows[nimbus::test::split_csv(line)[0]].push_back(nimbus::test::split_csv(line));
   EXPECT_EQ(rows["mc"].size(), 6u);  // 0..2, four bins, 6..inf
   EXPECT_EQ(rows["single"].size(), 4u);
   EXPECT_EQ(rows["mfs"].size(), 0u);

@@ -21,22 +21,8 @@ namespace {
 using nimbus::test::CliRun;
 using nimbus::test::run_cli;
 
-std::filesystem::path temp_dir() {
-  auto d = std::filesystem::temp_directory_path() / ("nimbus_cli_time_test_" + std::to_string(::getpid()));
-  std::filesystem::create_directories(d);
-  return d;
-}
-
-std::vector<std::string> split(const std::string& line) {
-  std::vector<std::string> v;
-  std::stringstream ss(line);
-  std::string item;
-  while (std::getline(ss, item, ',')) v.push_back(item);
-  return v;
-}
-
 TEST(CliTime, SlabWritesTimeRowsThatSumToTheSteadyValues) {
-  const auto dir = temp_dir();
+  const auto dir = nimbus::test::cli_temp_dir("cli_time_test");
   const auto out = dir / "time.csv";
   const CliRun r = run_cli(
       "slab --mu-s 1 --mu-a 0.1 --g 0.5 --thickness 1 --n 1.4 --photons 4000 --time-edges 1:3:4 "
@@ -55,7 +41,7 @@ TEST(CliTime, SlabWritesTimeRowsThatSumToTheSteadyValues) {
   std::getline(in, line);
   EXPECT_EQ(line, "tlo,thi,reflectance,reflectance_stderr,transmittance,transmittance_stderr");
   std::vector<std::vector<std::string>> rows;
-  while (std::getline(in, line)) rows.push_back(split(line));
+  while (std::getline(in, line)) rows.push_back(nimbus::test::split_csv(line));
   ASSERT_EQ(rows.size(), 6u);  // 0..1, four bins, 3..inf
   EXPECT_EQ(std::stod(rows.front()[0]), 0.0);
   EXPECT_EQ(std::stod(rows.front()[1]), 1.0);
@@ -83,7 +69,7 @@ TEST(CliTime, BeamAddsDelayRowsForMcAndMfs) {
   std::stringstream ss(r.out);
   std::string line;
   while (std::getline(ss, line)) {
-    const auto v = split(line);
+    const auto v = nimbus::test::split_csv(line);
     if (v.size() == 9 && v[2].rfind("delay", 0) == 0) ++count[v[0] + ":" + v[2]];
   }
   for (const char* m : {"mc", "mfs"}) {
@@ -97,12 +83,12 @@ std::vector<std::vector<std::string>> read_rows(const std::filesystem::path& pat
   std::ifstream in(path);
   std::vector<std::vector<std::string>> rows;
   std::string line;
-  while (std::getline(in, line)) rows.push_back(split(line));
+  while (std::getline(in, line)) rows.push_back(nimbus::test::split_csv(line));
   return rows;
 }
 
 TEST(CliTime, BeamJointTablesSumToTheDelayRows) {
-  const auto dir = temp_dir();
+  const auto dir = nimbus::test::cli_temp_dir("cli_time_test");
   const auto angle = dir / "angle.csv", radius = dir / "radius.csv";
   const CliRun r = run_cli(
       "beam --phase hg:0.9 --albedo 0.99 --depths 0.5,1 --photons 4000 --models mc,mfs,gsa "
@@ -114,7 +100,7 @@ TEST(CliTime, BeamJointTablesSumToTheDelayRows) {
   std::string line;
   int gsa_rows = 0;
   while (std::getline(ss, line)) {
-    const auto v = split(line);
+    const auto v = nimbus::test::split_csv(line);
     if (v.size() == 9 && v[2] == "delay" && v[0] != "gsa")
       delay[v[0] + ":" + v[1] + ":" + v[3]] = std::stod(v[5]);
     if (v.size() == 9 && v[0] == "gsa" && v[2].rfind("delay", 0) == 0) ++gsa_rows;
@@ -144,7 +130,7 @@ TEST(CliTime, BeamJointTablesSumToTheDelayRows) {
 }
 
 TEST(CliTime, BeamBadJointTablesExitWithCode2NamingTheArgument) {
-  const auto dir = temp_dir();
+  const auto dir = nimbus::test::cli_temp_dir("cli_time_test");
   const auto out = dir / "never.csv";
   const std::string beam = "beam --phase hg:0.9 --albedo 0.9 --photons 100 --depths 1 ";
   const struct {
@@ -168,7 +154,7 @@ TEST(CliTime, BeamBadJointTablesExitWithCode2NamingTheArgument) {
 const char* const kBadEdges[] = {"''", "2,1", "-1,1", "0:1:1e9", "5"};
 
 TEST(CliTime, SlabBadTimeEdgesExitWithCode2NamingTheArgument) {
-  const auto dir = temp_dir();
+  const auto dir = nimbus::test::cli_temp_dir("cli_time_test");
   const auto out = dir / "never.csv";
   const std::string slab =
       "slab --mu-s 1 --mu-a 0 --g 0 --thickness 1 --photons 100 --time-csv " + out.string();

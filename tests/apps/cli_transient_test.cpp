@@ -20,7 +20,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-void write_scene(const fs::path& file) {
+void write_transient_scene(const fs::path& file) {
   std::ofstream(file) << R"({"camera": {"position": [0, -4, 0], "look_at": [0, 0, 0], "up": [0, 0, 1],
     "fov_y_deg": 30, "width": 8, "height": 6},
     "media": [{"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1}, "sigma_s": 3.0}],
@@ -31,7 +31,7 @@ void write_scene(const fs::path& file) {
 
 TEST(CliTransient, WritesTheBinsBesideAnUnchangedImage) {
   const test::ScratchDir dir("cli_transient");
-  write_scene(dir / "s.json");
+  write_transient_scene(dir / "s.json");
   const std::string scene = (dir / "s.json").string();
   const test::CliRun plain =
       test::run_cli("render " + scene + " -o " + (dir / "plain.exr").string() + " --quiet");
@@ -57,7 +57,7 @@ TEST(CliTransient, WritesTheBinsBesideAnUnchangedImage) {
 
 TEST(CliTransient, BadBinsExitTwoNamingTheFieldAndWriteNothing) {
   const test::ScratchDir dir("cli_transient_bad");
-  write_scene(dir / "s.json");
+  write_transient_scene(dir / "s.json");
   const std::string scene = (dir / "s.json").string(), out = (dir / "o.exr").string();
   for (const std::string bins : {"", "8,2,4", "-1,2,4", "0,2,0", "0,2", "0,2,x", "0,1,100000000"}) {
     SCOPED_TRACE(bins);

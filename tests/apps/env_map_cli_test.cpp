@@ -16,12 +16,12 @@ namespace {
 namespace fs = std::filesystem;
 
 // Runs the CLI with stderr into `err`; returns its exit status.
-int run(const std::string& args, const fs::path& err) {
+int run_env(const std::string& args, const fs::path& err) {
   const int status = std::system((std::string(NIMBUS_CLI) + " " + args + " 2> " + err.string()).c_str());
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
-void write_scene(const fs::path& file, const std::string& light) {
+void write_env_scene(const fs::path& file, const std::string& light) {
   std::ofstream(file) << R"({"camera": {"position": [0, -4, 0], "look_at": [0, 0, 0], "up": [0, 0, 1],
     "fov_y_deg": 30, "width": 8, "height": 8}, "media": [], "lights": [)"
                       << light << R"(], "integrator": {"type": "pathtrace", "spp": 1}})";
@@ -38,8 +38,9 @@ TEST(EnvMapCli, RendersAndRejectsBadImages) {
   const fs::path err = dir / "err.txt";
 
   // A good image, relative to the scene's folder: the camera looks along +y, i.e. u = 1/4 (column 4).
-  write_scene(dir / "good.json", R"({"type": "environment", "file": "sky.exr", "intensity": 2})");
-  ASSERT_EQ(run("render -q " + (dir / "good.json").string() + " -o " + (dir / "good.exr").string(), err), 0);
+  write_env_scene(dir / "good.json", R"({"type": "environment", "file": "sky.exr", "intensity": 2})");
+  ASSERT_EQ(run_env("render -q " + (dir / "good.json").string() + " -o " + (dir / "good.exr").string(), err),
+            0);
   const Image img = read_exr(dir / "good.exr");
   EXPECT_NEAR(img.pixel(4, 4)[0], 2.0f, 1e-6f);
 
@@ -50,9 +51,9 @@ TEST(EnvMapCli, RendersAndRejectsBadImages) {
        {Case{R"({"type": "environment", "file": "missing.exr"})", "/lights/0/file"},
         Case{R"({"type": "environment", "file": "sky.png"})", "not an OpenEXR file"},
         Case{R"({"type": "environment", "file": "sky.exr", "radiance": 1})", "/lights/0/radiance"}}) {
-    write_scene(dir / "bad.json", c.light);
+    write_env_scene(dir / "bad.json", c.light);
     const fs::path out = dir / "bad.exr";
-    EXPECT_EQ(run("render -q " + (dir / "bad.json").string() + " -o " + out.string(), err), 2) << c.light;
+    EXPECT_EQ(run_env("render -q " + (dir / "bad.json").string() + " -o " + out.string(), err), 2) << c.light;
     EXPECT_FALSE(fs::exists(out)) << c.light;
     std::ifstream in(err);
     const std::string msg((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());

@@ -18,7 +18,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-void write_scene(const fs::path& file, const std::string& volume) {
+void write_vdb_scene(const fs::path& file, const std::string& volume) {
   std::ofstream(file) << R"({"camera": {"position": [0.25, -5, -0.25], "look_at": [0.25, 0, -0.25],
     "up": [0, 0, 1], "fov_y_deg": 35, "width": 10, "height": 8},
     "media": [{"shape": {"type": "vdb", "file": ")"
@@ -42,7 +42,7 @@ TEST(FramesCli, SequenceRendersEachFrameFromItsOwnFiles) {
   const test::ScratchDir dir("frames_seq");
   for (const char* name : {"cloud.0001.vdb", "cloud.0002.vdb", "cloud.0003.vdb"})
     fs::copy_file(fs::path(NIMBUS_SOURCE_DIR) / "fuzz" / "data" / "tiny.vdb", dir / name);
-  write_scene(dir / "seq.json", "cloud.$F4.vdb");
+  write_vdb_scene(dir / "seq.json", "cloud.$F4.vdb");
   fs::create_directories(dir / "out");
   ASSERT_EQ(run_cli_status("render " + (dir / "seq.json").string() + " --quiet --frames 1-3 -o '" +
                            (dir / "out" / "f.$F4.exr").string() + "' --preview '" +
@@ -56,14 +56,14 @@ TEST(FramesCli, SequenceRendersEachFrameFromItsOwnFiles) {
     EXPECT_EQ(meta_value(meta, "nimbus/frame"), std::to_string(f));
     EXPECT_NE(meta_value(meta, "nimbus/scene").find("cloud." + pad + ".vdb"), std::string::npos);
     // The same as the render of a scene that names the frame's file.
-    write_scene(dir / "one.json", "cloud." + pad + ".vdb");
+    write_vdb_scene(dir / "one.json", "cloud." + pad + ".vdb");
     ASSERT_EQ(
         run_cli_status("render " + (dir / "one.json").string() + " --quiet -o " + (dir / "one.exr").string()),
         0);
     EXPECT_TRUE(same_pixels(frame, read_exr(dir / "one.exr"))) << f;
   }
   // Every 2nd frame, and a list; $F in a --set value too.
-  write_scene(dir / "plain.json", "none.vdb");
+  write_vdb_scene(dir / "plain.json", "none.vdb");
   ASSERT_EQ(
       run_cli_status("render " + (dir / "plain.json").string() + " --quiet --frames 1-3x2 --set " +
                      "'media.0.shape.file=cloud.$F4.vdb' -o '" + (dir / "out" / "s$F.exr").string() + "'"),
@@ -85,7 +85,7 @@ TEST(FramesCli, SequenceRendersEachFrameFromItsOwnFiles) {
 TEST(FramesCli, BadListsAndOutputsWithoutAFrameNumberAreRejected) {
   const test::ScratchDir dir("frames_bad");
   fs::copy_file(fs::path(NIMBUS_SOURCE_DIR) / "fuzz" / "data" / "tiny.vdb", dir / "c1.vdb");
-  write_scene(dir / "s.json", "c$F.vdb");
+  write_vdb_scene(dir / "s.json", "c$F.vdb");
   const std::string s = "render " + (dir / "s.json").string() + " --quiet ";
   for (const char* bad :
        {"", "3-1", "1-", "-3", "a", "1-5x0", "1,,2", "1,1", "1-3,2", "1x2", "1-3y2", "0-100000000"}) {

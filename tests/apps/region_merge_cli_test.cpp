@@ -20,7 +20,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-void write_scene(const fs::path& file, int spp) {
+void write_merge_scene(const fs::path& file, int spp) {
   std::ofstream(file) << R"({"camera": {"position": [0, -4, 0], "look_at": [0, 0, 0], "up": [0, 0, 1],
     "fov_y_deg": 30, "width": 14, "height": 10},
     "media": [{"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1}, "sigma_s": 5.0,
@@ -63,7 +63,7 @@ void expect_crop_of(const fs::path& crop_file, const fs::path& full_file) {
 
 TEST(RegionCli, CropEqualsTheFullRenderBitForBit) {
   const test::ScratchDir dir("region_crop");
-  write_scene(dir / "s.json", 3);
+  write_merge_scene(dir / "s.json", 3);
   const std::string s = (dir / "s.json").string() + " --quiet ";
   ASSERT_EQ(run_cli_status("render " + s + "-o " + (dir / "full.exr").string()), 0);
   // An odd window, on one thread with small tiles: neither the tiling nor the threads matter.
@@ -87,7 +87,7 @@ TEST(RegionCli, CropEqualsTheFullRenderBitForBit) {
 
 TEST(RegionCli, WindowOutsideTheImageIsRejected) {
   const test::ScratchDir dir("region_bad");
-  write_scene(dir / "s.json", 1);
+  write_merge_scene(dir / "s.json", 1);
   const std::string s = "render " + (dir / "s.json").string() + " --quiet -o " + (dir / "x.exr").string();
   for (const char* bad :
        {"0,0,15,10", "0,0,14,11", "5,5,5,8", "4,4,2,8", "-1,0,4,4", "1,2,3", "a,b,c,d", "0,0,4,4,5"}) {
@@ -102,7 +102,7 @@ TEST(RegionCli, WindowOutsideTheImageIsRejected) {
 
 TEST(MergeCli, TilesAssembleIntoTheFullRenderBitForBit) {
   const test::ScratchDir dir("merge_tiles");
-  write_scene(dir / "s.json", 2);
+  write_merge_scene(dir / "s.json", 2);
   const std::string s = "render " + (dir / "s.json").string() + " --quiet ";
   ASSERT_EQ(run_cli_status(s + "-o " + (dir / "full.exr").string()), 0);
   const char* tiles[] = {"0,0,5,4", "5,0,14,4", "0,4,9,10", "9,4,14,10"};
@@ -134,7 +134,7 @@ TEST(MergeCli, TilesAssembleIntoTheFullRenderBitForBit) {
 
 TEST(MergeCli, SampleRangesAddUpToTheRenderOfAllSamples) {
   const test::ScratchDir dir("merge_samples");
-  write_scene(dir / "s.json", 5);
+  write_merge_scene(dir / "s.json", 5);
   const std::string s = "render " + (dir / "s.json").string() + " --quiet ";
   ASSERT_EQ(run_cli_status(s + "-o " + (dir / "full.exr").string()), 0);
   ASSERT_EQ(run_cli_status(s + "--samples 0:5 -o " + (dir / "all.exr").string()),
@@ -172,7 +172,7 @@ TEST(MergeCli, SampleRangesAddUpToTheRenderOfAllSamples) {
 
 TEST(MergeCli, IncompatibleInputsAreRefusedNamingFileAndField) {
   const test::ScratchDir dir("merge_bad");
-  write_scene(dir / "s.json", 2);
+  write_merge_scene(dir / "s.json", 2);
   const std::string s = "render " + (dir / "s.json").string() + " --quiet ";
   ASSERT_EQ(run_cli_status(s + "--samples 0:2 -o " + (dir / "a.exr").string()), 0);
   struct Case {
@@ -202,7 +202,7 @@ TEST(MergeCli, IncompatibleInputsAreRefusedNamingFileAndField) {
 
 TEST(MergeCli, NonRendersAndBadSampleRangesAreRefused) {
   const test::ScratchDir dir("merge_bad_ranges");
-  write_scene(dir / "s.json", 2);
+  write_merge_scene(dir / "s.json", 2);
   const std::string s = "render " + (dir / "s.json").string() + " --quiet ";
   ASSERT_EQ(run_cli_status(s + "--samples 0:2 -o " + (dir / "a.exr").string()), 0);
   // Not a nimbus render, --samples beside --spp, a bad range: exit 2.

@@ -12,14 +12,16 @@
 #include <thread>
 
 #include "nimbus/image.h"
+#include "support/cli.h"
 #include "support/scratch_dir.h"
 
 namespace nimbus {
 namespace {
 
 namespace fs = std::filesystem;
+using test::meta_value;
 
-void write_scene(const fs::path& file, int size, int spp) {
+void write_render_scene(const fs::path& file, int size, int spp) {
   std::ofstream(file) << R"({"camera": {"position": [0, -4, 0], "look_at": [0, 0, 0], "up": [0, 0, 1],
     "fov_y_deg": 30, "width": )"
                       << size << R"(, "height": )" << size << R"(},
@@ -31,23 +33,17 @@ void write_scene(const fs::path& file, int size, int spp) {
                       << spp << "}}";
 }
 
-int run(const std::string& args) {
+int run_render(const std::string& args) {
   const int status = std::system((std::string(NIMBUS_CLI) + " " + args).c_str());
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
-std::string meta_value(const ImageMetadata& meta, const std::string& key) {
-  for (const auto& [k, v] : meta)
-    if (k == key) return v;
-  return "(missing)";
 }
 
 TEST(RenderCli, WritesExrWithHeaderAndPreview) {
   const test::ScratchDir scratch("render_cli_ok");
   const fs::path& dir = scratch.path;
-  write_scene(dir / "s.json", 16, 2);
-  ASSERT_EQ(run("render " + (dir / "s.json").string() + " -o " + (dir / "a.exr").string() + " --preview " +
-                (dir / "a.png").string() + " --quiet --seed 3"),
+  write_render_scene(dir / "s.json", 16, 2);
+  ASSERT_EQ(run_render("render " + (dir / "s.json").string() + " -o " + (dir / "a.exr").string() +
+                       " --preview " + (dir / "a.png").string() + " --quiet --seed 3"),
             0);
   ImageMetadata meta;
   const Image img = read_exr(dir / "a.exr", &meta);
@@ -62,16 +58,16 @@ TEST(RenderCli, WritesExrWithHeaderAndPreview) {
 TEST(RenderCli, FailedRunKeepsTheExistingOutput) {
   const test::ScratchDir scratch("render_cli_keep");
   const fs::path& dir = scratch.path;
-  write_scene(dir / "s.json", 8, 1);
+  write_render_scene(dir / "s.json", 8, 1);
   std::ofstream(dir / "out.exr") << "precious";
-  EXPECT_EQ(run("render " + (dir / "s.json").string() + " -o " + (dir / "out.exr").string() +
-                " --integrator nope --quiet 2>/dev/null"),
+  EXPECT_EQ(run_render("render " + (dir / "s.json").string() + " -o " + (dir / "out.exr").string() +
+                       " --integrator nope --quiet 2>/dev/null"),
             2);
-  EXPECT_EQ(run("render " + (dir / "s.json").string() + " -o " + (dir / "out.tif").string() +
-                " --quiet 2>/dev/null"),
+  EXPECT_EQ(run_render("render " + (dir / "s.json").string() + " -o " + (dir / "out.tif").string() +
+                       " --quiet 2>/dev/null"),
             2);
-  EXPECT_EQ(run("render " + (dir / "s.json").string() + " -o " + (dir / "nodir" / "x.exr").string() +
-                " --quiet 2>/dev/null"),
+  EXPECT_EQ(run_render("render " + (dir / "s.json").string() + " -o " + (dir / "nodir" / "x.exr").string() +
+                       " --quiet 2>/dev/null"),
             2);
   std::ifstream in(dir / "out.exr");
   std::string content;
@@ -85,7 +81,7 @@ TEST(RenderCli, FailedRunKeepsTheExistingOutput) {
 TEST(RenderCli, SigintWritesAFlaggedPartialImage) {
   const test::ScratchDir scratch("render_cli_sigint");
   const fs::path& dir = scratch.path;
-  write_scene(dir / "s.json", 32, 1 << 20);  // hours of work: it will be interrupted
+  write_render_scene(dir / "s.json", 32, 1 << 20);  // hours of work: it will be interrupted
   std::ofstream(dir / "out.exr") << "precious";
   const pid_t pid = fork();
   ASSERT_GE(pid, 0);
@@ -123,12 +119,12 @@ TEST(RenderCli, SigintWritesAFlaggedPartialImage) {
 TEST(RenderCli, ResumeEqualsOneRenderBitForBit) {
   const test::ScratchDir scratch("render_cli_resume");
   const fs::path& dir = scratch.path;
-  write_scene(dir / "s.json", 12, 6);
+  write_render_scene(dir / "s.json", 12, 6);
   const std::string s = (dir / "s.json").string() + " --quiet --layers depth,direct ";
-  ASSERT_EQ(run("render " + s + "-o " + (dir / "one.exr").string()), 0);
-  ASSERT_EQ(run("render " + s + "-o " + (dir / "two.exr").string() + " --spp 3 --threads 1"), 0);
+  ASSERT_EQ(run_render("render " + s + "-o " + (dir / "one.exr").string()), 0);
+  ASSERT_EQ(run_render("render " + s + "-o " + (dir / "two.exr").string() + " --spp 3 --threads 1"), 0);
   // Continued in place, on two threads, to 6 spp.
-  ASSERT_EQ(run("render --quiet --resume " + (dir / "two.exr").string() + " --threads 2 --spp 6"), 0);
+  ASSERT_EQ(run_render("render --quiet --resume " + (dir / "two.exr").string() + " --threads 2 --spp 6"), 0);
   ImageMetadata meta;
   const Image one = read_exr(dir / "one.exr"), two = read_exr(dir / "two.exr", &meta);
   EXPECT_EQ(meta_value(meta, "nimbus/spp"), "6");
@@ -141,12 +137,12 @@ TEST(RenderCli, ResumeEqualsOneRenderBitForBit) {
     EXPECT_EQ(a.layers[l].sums, b.layers[l].sums) << a.layers[l].name;
   // Nothing to add, a scene beside --resume, or a file without a state: exit 2, the file untouched.
   const auto before = fs::last_write_time(dir / "two.exr");
-  EXPECT_EQ(run("render --quiet --resume " + (dir / "two.exr").string() + " 2>/dev/null"), 2);
-  EXPECT_EQ(run("render " + s + "--resume " + (dir / "two.exr").string() + " --spp 9 2>/dev/null"), 2);
+  EXPECT_EQ(run_render("render --quiet --resume " + (dir / "two.exr").string() + " 2>/dev/null"), 2);
+  EXPECT_EQ(run_render("render " + s + "--resume " + (dir / "two.exr").string() + " --spp 9 2>/dev/null"), 2);
   EXPECT_EQ(fs::last_write_time(dir / "two.exr"), before);
   write_exr(dir / "plain.exr", one);
-  EXPECT_EQ(run("render --quiet --resume " + (dir / "plain.exr").string() + " --spp 9 -o " +
-                (dir / "x.exr").string() + " 2>/dev/null"),
+  EXPECT_EQ(run_render("render --quiet --resume " + (dir / "plain.exr").string() + " --spp 9 -o " +
+                       (dir / "x.exr").string() + " 2>/dev/null"),
             2);
   EXPECT_FALSE(fs::exists(dir / "x.exr"));
 }
@@ -154,9 +150,9 @@ TEST(RenderCli, ResumeEqualsOneRenderBitForBit) {
 TEST(RenderCli, TimeLimitGivesAWholeImageAtFewerSamples) {
   const test::ScratchDir scratch("render_cli_time");
   const fs::path& dir = scratch.path;
-  write_scene(dir / "s.json", 16, 1 << 20);
-  ASSERT_EQ(run("render " + (dir / "s.json").string() + " -o " + (dir / "t.exr").string() +
-                " --quiet --time 0.5 --threads 1 2>/dev/null"),
+  write_render_scene(dir / "s.json", 16, 1 << 20);
+  ASSERT_EQ(run_render("render " + (dir / "s.json").string() + " -o " + (dir / "t.exr").string() +
+                       " --quiet --time 0.5 --threads 1 2>/dev/null"),
             0);
   ImageMetadata meta;
   read_exr(dir / "t.exr", &meta);
@@ -170,16 +166,20 @@ TEST(RenderCli, TimeLimitGivesAWholeImageAtFewerSamples) {
 TEST(RenderCli, ConvertWritesAPngAndRejectsBadInput) {
   const test::ScratchDir scratch("render_cli_convert");
   const fs::path& dir = scratch.path;
-  write_scene(dir / "s.json", 8, 1);
-  ASSERT_EQ(run("render " + (dir / "s.json").string() + " -o " + (dir / "a.exr").string() + " --quiet"), 0);
-  ASSERT_EQ(run("convert " + (dir / "a.exr").string() + " " + (dir / "a.png").string() + " --exposure 1"), 0);
+  write_render_scene(dir / "s.json", 8, 1);
+  ASSERT_EQ(
+      run_render("render " + (dir / "s.json").string() + " -o " + (dir / "a.exr").string() + " --quiet"), 0);
+  ASSERT_EQ(
+      run_render("convert " + (dir / "a.exr").string() + " " + (dir / "a.png").string() + " --exposure 1"),
+      0);
   EXPECT_GT(fs::file_size(dir / "a.png"), 0u);
   std::ofstream(dir / "bad.exr") << "not an exr";
-  EXPECT_EQ(run("convert " + (dir / "bad.exr").string() + " " + (dir / "b.png").string() + " 2>/dev/null"),
-            2);
+  EXPECT_EQ(
+      run_render("convert " + (dir / "bad.exr").string() + " " + (dir / "b.png").string() + " 2>/dev/null"),
+      2);
   EXPECT_FALSE(fs::exists(dir / "b.png"));
-  EXPECT_EQ(run("render " + (dir / "s.json").string() + " -o " + (dir / "c.exr").string() +
-                " --integrator mfs --quiet"),
+  EXPECT_EQ(run_render("render " + (dir / "s.json").string() + " -o " + (dir / "c.exr").string() +
+                       " --integrator mfs --quiet"),
             0);
 }
 

@@ -18,7 +18,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-void write_scene(const fs::path& file) {
+void write_layers_scene(const fs::path& file) {
   std::ofstream(file) << R"({"camera": {"position": [0, -4, 0], "look_at": [0, 0, 0], "up": [0, 0, 1],
     "fov_y_deg": 30, "width": 8, "height": 8},
     "media": [{"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1}, "sigma_s": 5.0}],
@@ -28,7 +28,7 @@ void write_scene(const fs::path& file) {
 }
 
 // Exit code of `nimbus ARGS`, stderr into *err.
-int run(const std::string& args, const fs::path& dir, std::string* err) {
+int run_layers(const std::string& args, const fs::path& dir, std::string* err) {
   const fs::path log = dir / "stderr.txt";
   const int status = std::system((std::string(NIMBUS_CLI) + " " + args + " 2> " + log.string()).c_str());
   std::ostringstream text;
@@ -39,12 +39,12 @@ int run(const std::string& args, const fs::path& dir, std::string* err) {
 
 TEST(RenderLayersCli, LayersAndDeepFiles) {
   const test::ScratchDir dir("render_layers_cli");
-  write_scene(dir / "s.json");
+  write_layers_scene(dir / "s.json");
   std::string err;
-  ASSERT_EQ(run("render " + (dir / "s.json").string() + " -o " + (dir / "a.exr").string() +
-                    " --layers depth,normal,samples,indirect --deep " + (dir / "d.exr").string() +
-                    " --deep-samples 4 --quiet",
-                dir.path, &err),
+  ASSERT_EQ(run_layers("render " + (dir / "s.json").string() + " -o " + (dir / "a.exr").string() +
+                           " --layers depth,normal,samples,indirect --deep " + (dir / "d.exr").string() +
+                           " --deep-samples 4 --quiet",
+                       dir.path, &err),
             0)
       << err;
   Imf::InputFile file((dir / "a.exr").c_str());
@@ -69,16 +69,18 @@ TEST(RenderLayersCli, LayersAndDeepFiles) {
 
 TEST(RenderLayersCli, BadLayerOrDeepOptionsExitTwoNamingTheOption) {
   const test::ScratchDir dir("render_layers_bad");
-  write_scene(dir / "s.json");
+  write_layers_scene(dir / "s.json");
   const std::string base = "render " + (dir / "s.json").string() + " --quiet -o ";
   std::string err;
-  EXPECT_EQ(run(base + (dir / "a.exr").string() + " --layers depth,zdepth", dir.path, &err), 2);
+  EXPECT_EQ(run_layers(base + (dir / "a.exr").string() + " --layers depth,zdepth", dir.path, &err), 2);
   EXPECT_NE(err.find("--layers"), std::string::npos) << err;
-  EXPECT_EQ(run(base + (dir / "a.png").string() + " --layers depth", dir.path, &err), 2);
+  EXPECT_EQ(run_layers(base + (dir / "a.png").string() + " --layers depth", dir.path, &err), 2);
   EXPECT_NE(err.find("--layers"), std::string::npos) << err;
-  EXPECT_EQ(run(base + (dir / "a.exr").string() + " --deep " + (dir / "d.png").string(), dir.path, &err), 2);
+  EXPECT_EQ(
+      run_layers(base + (dir / "a.exr").string() + " --deep " + (dir / "d.png").string(), dir.path, &err), 2);
   EXPECT_NE(err.find("--deep"), std::string::npos) << err;
-  EXPECT_EQ(run(base + (dir / "a.exr").string() + " --deep " + (dir / "d.exr").string() + " --deep-samples 0",
+  EXPECT_EQ(run_layers(
+                base + (dir / "a.exr").string() + " --deep " + (dir / "d.exr").string() + " --deep-samples 0",
                 dir.path, &err),
             2);
   EXPECT_NE(err.find("--deep-samples"), std::string::npos) << err;

@@ -17,7 +17,7 @@ namespace {
 namespace fs = std::filesystem;
 
 // A small scene: a ground rectangle and a mesh surface from `mesh_file`, under a sun.
-void write_scene(const fs::path& file, const std::string& mesh_file) {
+void write_mesh_scene(const fs::path& file, const std::string& mesh_file) {
   std::ofstream(file) << R"({"camera": {"position": [0, -4, 1], "look_at": [0, 0, 0], "up": [0, 0, 1],
     "fov_y_deg": 40, "width": 8, "height": 8},
     "media": [],
@@ -77,7 +77,7 @@ TEST(SurfacesCli, BadMeshesExitTwoNamingFileAndFieldAndWriteNothing) {
   };
   for (const Case& c : cases) {
     if (!c.content.empty()) std::ofstream(dir / c.file) << c.content;
-    write_scene(dir / "scene.json", c.file);
+    write_mesh_scene(dir / "scene.json", c.file);
     const std::set<std::string> before = files_in(dir);
     const RunResult r = render(dir, logs / "err.txt");
     EXPECT_EQ(r.status, 2) << c.file;
@@ -91,7 +91,7 @@ TEST(SurfacesCli, BadMeshKeepsTheExistingOutput) {
   const test::ScratchDir scratch("surfaces_cli_keep");
   const test::ScratchDir logs("surfaces_cli_keep_logs");
   const fs::path& dir = scratch.path;
-  write_scene(dir / "scene.json", "gone.obj");
+  write_mesh_scene(dir / "scene.json", "gone.obj");
   std::ofstream(dir / "out.exr") << "precious";
   EXPECT_EQ(render(dir, logs / "err.txt").status, 2);
   std::ifstream in(dir / "out.exr");
@@ -107,7 +107,7 @@ TEST(SurfacesCli, AGoodMeshRenders) {
   const fs::path& dir = scratch.path;
   fs::create_directories(dir / "meshes");
   std::ofstream(dir / "meshes" / "quad.obj") << "v -1 0 0\nv 1 0 0\nv 1 0 1\nv -1 0 1\nf 1 2 3 4\n";
-  write_scene(dir / "scene.json", "meshes/quad.obj");
+  write_mesh_scene(dir / "scene.json", "meshes/quad.obj");
   const RunResult r = render(dir, logs / "err.txt");
   EXPECT_EQ(r.status, 0) << r.first_line;
   EXPECT_TRUE(fs::exists(dir / "out.exr"));

@@ -11,6 +11,7 @@
 #include "media/blackbody.h"
 #include "nimbus/error.h"
 #include "scene/context.h"
+#include "support/estimate.h"
 #include "support/scenes.h"
 #include "support/scratch_dir.h"
 #include "support/stats.h"
@@ -20,19 +21,6 @@ namespace {
 
 using test::MeanAccumulator;
 using test::scene_from_json;
-
-struct ChannelStats {
-  MeanAccumulator c[3];
-};
-ChannelStats estimate(const Integrator& it, const Vec3& o, const Vec3& d, int n, uint64_t seed = 1) {
-  ChannelStats s;
-  for (int i = 0; i < n; ++i) {
-    Rng rng(seed, uint64_t(i));
-    const Rgb L = it.Li({o, d}, rng);
-    for (int k = 0; k < 3; ++k) s.c[k].add(L[k]);
-  }
-  return s;
-}
 
 // mfs with fewer photons than its default (fast tests).
 std::unique_ptr<Integrator> make(const SceneContext& ctx, const std::string& type, int photons = 1 << 15) {
@@ -64,13 +52,13 @@ TEST(Emission, EmissionAbsorptionClosedFormEveryIntegrator) {
     const SceneContext ctx(scene);
     const Rgb exact = emission_absorption(kJ, kSigmaA, L);
     const Vec3 o(0, -4, 0), d(0, 1, 0);
-    const auto pt = estimate(*make(ctx, "pathtrace"), o, d, 20000);
+    const auto pt = test::estimate_li(*make(ctx, "pathtrace"), o, d, 20000);
     for (int k = 0; k < 3; ++k) {
       EXPECT_NEAR(pt.c[k].mean, exact[k], 5.0 * pt.c[k].stderr_mean() + 1e-12) << shape << k;
       EXPECT_LT(pt.c[k].stderr_mean(), 0.02 * exact[k]);  // the test has the power to see a 10% error
     }
     for (const char* type : {"single", "octave", "mfs"}) {
-      const auto s = estimate(*make(ctx, type), o, d, 8);
+      const auto s = test::estimate_li(*make(ctx, type), o, d, 8);
       for (int k = 0; k < 3; ++k)
         EXPECT_NEAR(s.c[k].mean, exact[k], 1e-3 * exact[k]) << type << " " << L << k;
     }
@@ -84,11 +72,11 @@ TEST(Emission, TransparentEmitterIsSeen) {
       {"shape": {"type": "box", "min": [-2, -0.75, -2], "max": [2, 0.75, 2]}, "sigma_s": 0, "emission": 0.4}]})");
   const SceneContext ctx(scene);
   const Vec3 o(0, -4, 0), d(0, 1, 0);
-  const auto pt = estimate(*make(ctx, "pathtrace"), o, d, 4000);
+  const auto pt = test::estimate_li(*make(ctx, "pathtrace"), o, d, 4000);
   EXPECT_NEAR(pt.c[0].mean, 0.6, 5.0 * pt.c[0].stderr_mean() + 1e-12);
   EXPECT_LT(pt.c[0].stderr_mean(), 0.02 * 0.6);
   for (const char* type : {"single", "octave", "mfs"})
-    EXPECT_NEAR(estimate(*make(ctx, type), o, d, 4).c[0].mean, 0.6, 1e-5) << type;
+    EXPECT_NEAR(test::estimate_li(*make(ctx, type), o, d, 4).c[0].mean, 0.6, 1e-5) << type;
 }
 
 // A furnace with emission: deep inside a large scattering and absorbing sphere with uniform emission j the
@@ -101,7 +89,7 @@ TEST(Emission, FurnaceWithEmission) {
   const SceneContext ctx(scene);
   const Rgb exact(1.0, 0.5, 0.25);  // the diffusion length 1 / sqrt(3 sigma_a sigma_t) is 1/15 of the radius
   const Vec3 o(0, 0, 0), d = normalize(Vec3(0.3, 1, 0.2));
-  const auto pt = estimate(*make(ctx, "pathtrace"), o, d, 4000);
+  const auto pt = test::estimate_li(*make(ctx, "pathtrace"), o, d, 4000);
   for (int k = 0; k < 3; ++k) {
     EXPECT_NEAR(pt.c[k].mean, exact[k], 5.0 * pt.c[k].stderr_mean() + 1e-9 * exact[k]) << k;
     EXPECT_LT(pt.c[k].stderr_mean(), 0.03 * exact[k]);
@@ -112,7 +100,7 @@ TEST(Emission, FurnaceWithEmission) {
   Rgb mean(0.0);
   for (int k = 0; k < 27; ++k) {
     const Vec3 p(k % 3 - 1.0, k / 3 % 3 - 1.0, k / 9 - 1.0);
-    const auto s = estimate(*mfs_integrator, p * 0.8, d, 1, uint64_t(k));
+    const auto s = test::estimate_li(*mfs_integrator, p * 0.8, d, 1, uint64_t(k));
     for (int c = 0; c < 3; ++c) mean[c] += s.c[c].mean / 27.0;
   }
   for (int k = 0; k < 3; ++k) EXPECT_NEAR(mean[k], exact[k], 0.05 * exact[k]) << k;
@@ -155,13 +143,13 @@ TEST(Emission, BlackbodyFromTemperatureGrid) {
   const Rgb sigma_a(0.5, 1.0, 2.0);
   Rgb exact;
   for (int k = 0; k < 3; ++k) exact[k] = B[k] * (1.0 - std::exp(-sigma_a[k] * 1.6));
-  const auto pt = estimate(*make(ctx, "pathtrace"), o, d, 20000);
+  const auto pt = test::estimate_li(*make(ctx, "pathtrace"), o, d, 20000);
   for (int k = 0; k < 2; ++k) {  // blue is clamped to 0 at 2000 K
     EXPECT_NEAR(pt.c[k].mean, exact[k], 5.0 * pt.c[k].stderr_mean()) << k;
     EXPECT_LT(pt.c[k].stderr_mean(), 0.02 * exact[k]);
   }
   for (const char* type : {"single", "octave", "mfs"}) {
-    const auto s = estimate(*make(ctx, type), o, d, 8);
+    const auto s = test::estimate_li(*make(ctx, type), o, d, 8);
     // mfs's steps grow with depth (its step_growth), so the density's ramps are sampled more coarsely.
     const double tol = std::string(type) == "mfs" ? 5e-3 : 1e-3;
     for (int k = 0; k < 3; ++k) EXPECT_NEAR(s.c[k].mean, exact[k], tol * exact[0]) << type << k;
@@ -180,11 +168,11 @@ TEST(Emission, EmissionGridBeyondTheDensity) {
        "sigma_s": 0, "emission": 2, "emission_grid": "temperature"}]})");
   const SceneContext ctx(scene);
   const Vec3 o(0.01, -4, 0.02), d(0, 1, 0);
-  const auto pt = estimate(*make(ctx, "pathtrace"), o, d, 4000);
+  const auto pt = test::estimate_li(*make(ctx, "pathtrace"), o, d, 4000);
   EXPECT_NEAR(pt.c[0].mean, 4.0, 5.0 * pt.c[0].stderr_mean() + 1e-12);
   EXPECT_LT(pt.c[0].stderr_mean(), 0.02 * 4.0);
   for (const char* type : {"single", "octave", "mfs"})
-    EXPECT_NEAR(estimate(*make(ctx, type), o, d, 4).c[0].mean, 4.0, 2e-3 * 4.0) << type;
+    EXPECT_NEAR(test::estimate_li(*make(ctx, type), o, d, 4).c[0].mean, 4.0, 2e-3 * 4.0) << type;
 }
 
 // The procedural fire of data/volumes/ draws density, temperature (another voxel size) and a vec3
@@ -219,7 +207,7 @@ TEST(Emission, FireFileDrawsSeveralGrids) {
   EXPECT_GT(hottest, 0.0);
 }
 
-std::string load_error(const std::string& text) {
+std::string emission_load_error(const std::string& text) {
   try {
     scene_from_json(text);
   } catch (const Error& e) {
@@ -233,24 +221,24 @@ TEST(Emission, BadInput) {
   write_fire(dir / "fire.nvdb", 15.0f);
   const std::string head = "{" + test::camera_json() + R"(, "lights": [], )";
   // A grid named but absent: the scene file, the field and the volume file.
-  std::string msg = load_error(head + fire_medium(dir / "fire.nvdb", "", "heat") + "}");
+  std::string msg = emission_load_error(head + fire_medium(dir / "fire.nvdb", "", "heat") + "}");
   EXPECT_NE(msg.find("test.json: /media/0/temperature_grid"), std::string::npos) << msg;
   EXPECT_NE(msg.find("fire.nvdb: no grid named \"heat\""), std::string::npos) << msg;
   // Negative temperatures after scale and offset.
-  msg = load_error(head + fire_medium(dir / "fire.nvdb", R"(, "temperature_offset": -2000)") + "}");
+  msg = emission_load_error(head + fire_medium(dir / "fire.nvdb", R"(, "temperature_offset": -2000)") + "}");
   EXPECT_NE(msg.find("/media/0/temperature_offset"), std::string::npos) << msg;
   EXPECT_NE(msg.find("must be >= 0"), std::string::npos) << msg;
-  msg = load_error(head + fire_medium(dir / "fire.nvdb", R"(, "temperature_scale": -1)") + "}");
+  msg = emission_load_error(head + fire_medium(dir / "fire.nvdb", R"(, "temperature_scale": -1)") + "}");
   EXPECT_NE(msg.find("/media/0/temperature_scale"), std::string::npos) << msg;
   // Negative emission, grids on a shape without a file, stray fields.
   const std::string sphere = R"("media": [{"shape": {"type": "sphere", "radius": 1}, "sigma_s": 1, )";
-  msg = load_error(head + sphere + R"("emission": [1, -1, 0]}]})");
+  msg = emission_load_error(head + sphere + R"("emission": [1, -1, 0]}]})");
   EXPECT_NE(msg.find("/media/0/emission"), std::string::npos) << msg;
-  msg = load_error(head + sphere + R"("emission": 1, "emission_grid": "flame"}]})");
+  msg = emission_load_error(head + sphere + R"("emission": 1, "emission_grid": "flame"}]})");
   EXPECT_NE(msg.find("/media/0/emission_grid"), std::string::npos) << msg;
-  msg = load_error(head + sphere + R"("intensity": 2}]})");
+  msg = emission_load_error(head + sphere + R"("intensity": 2}]})");
   EXPECT_NE(msg.find("/media/0/intensity: needs a temperature_grid"), std::string::npos) << msg;
-  msg = load_error(head + sphere + R"("emision": 1}]})");
+  msg = emission_load_error(head + sphere + R"("emision": 1}]})");
   EXPECT_NE(msg.find("emision"), std::string::npos) << msg;
 }
 

@@ -181,7 +181,7 @@ TEST(EnvMapRender, ScatterGridLeavesTheImagesFirstScatterToTheMarch) {
   }
 }
 
-std::string parse_error(const nlohmann::json& doc) {
+std::string env_parse_error(const nlohmann::json& doc) {
   try {
     parse_scene(doc, "scene.json", ".");
   } catch (const Error& e) {
@@ -235,16 +235,16 @@ TEST(EnvMapParse, BadInputsNameTheFileAndField) {
       {{{"type", "environment"}, {"file", good}, {"exposure", 1.0}}, "exposure"},
   };
   for (const Case& c : cases) {
-    const std::string msg = parse_error(scene(c.light));
+    const std::string msg = env_parse_error(scene(c.light));
     EXPECT_NE(msg.find("scene.json"), std::string::npos) << msg;
     EXPECT_NE(msg.find(c.needle), std::string::npos) << msg;
   }
-  EXPECT_NE(parse_error(scene({{"type", "environment"}, {"file", png}})).find("/lights/0/file"),
+  EXPECT_NE(env_parse_error(scene({{"type", "environment"}, {"file", png}})).find("/lights/0/file"),
             std::string::npos);
   // Two images in one scene.
   nlohmann::json two = scene({{"type", "environment"}, {"file", good}});
   two["lights"].push_back({{"type", "environment"}, {"file", good}});
-  EXPECT_NE(parse_error(two).find("/lights/1/file"), std::string::npos);
+  EXPECT_NE(env_parse_error(two).find("/lights/1/file"), std::string::npos);
   // Rotations are fine, and a relative path resolves against the scene's folder.
   const Scene ok = parse_scene(scene({{"type", "environment"},
                                       {"file", "sky.exr"},

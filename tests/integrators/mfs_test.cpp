@@ -22,7 +22,7 @@ namespace {
 
 // Integral over the sphere of a function of cos theta (midpoint rule in theta, dense near 0).
 template <typename F>
-double sphere_integral(F&& f) {
+double mfs_sphere_integral(F&& f) {
   const int n = 20000;
   double s = 0.0;
   for (int i = 0; i < n; ++i) {
@@ -39,8 +39,8 @@ TEST(PhaseSplit, PartsAreNormalisedAndRecombine) {
     const PhaseSplit split(phase, auto_peak_fraction(phase));
     const double f = split.f();
     EXPECT_NEAR(f, auto_peak_fraction(phase), 2e-3) << phase_describe(phase);
-    EXPECT_NEAR(sphere_integral([&](double mu) { return split.wide(mu); }), 1.0, 2e-3);
-    EXPECT_NEAR(sphere_integral([&](double mu) { return split.peak(mu); }), 1.0, 2e-3);
+    EXPECT_NEAR(mfs_sphere_integral([&](double mu) { return split.wide(mu); }), 1.0, 2e-3);
+    EXPECT_NEAR(mfs_sphere_integral([&](double mu) { return split.peak(mu); }), 1.0, 2e-3);
     for (double mu : {-0.9, 0.0, 0.5, 0.95, 0.999}) {
       EXPECT_NEAR(f * split.peak(mu) + (1 - f) * split.wide(mu), phase_eval(phase, mu),
                   1e-9 * phase_eval(phase, mu) + 1e-12);
@@ -54,8 +54,8 @@ TEST(PhaseSplit, PartsAreNormalisedAndRecombine) {
     }
     // Peak scatters conserve the light: each propagated part integrates to 1 at every depth.
     for (double tau : {0.3, 2.0, 10.0, 40.0}) {
-      EXPECT_NEAR(sphere_integral([&](double mu) { return split.wide_eff(tau, mu); }), 1.0, 0.02) << tau;
-      EXPECT_NEAR(sphere_integral([&](double mu) { return split.peak_eff(tau, mu); }), 1.0, 0.02) << tau;
+      EXPECT_NEAR(mfs_sphere_integral([&](double mu) { return split.wide_eff(tau, mu); }), 1.0, 0.02) << tau;
+      EXPECT_NEAR(mfs_sphere_integral([&](double mu) { return split.peak_eff(tau, mu); }), 1.0, 0.02) << tau;
     }
     // Propagation spreads the peak: less light straight ahead after more peak depth.
     EXPECT_LT(split.peak_eff(5.0, 1.0), split.peak_eff(0.5, 1.0));
@@ -72,7 +72,7 @@ TEST(PhaseSplit, NoPeakIsThePhaseFunction) {
           << tau << " " << mu;
 }
 
-std::string sphere_scene(double sigma_s, double sigma_a, double g, bool env) {
+std::string mfs_sphere_scene(double sigma_s, double sigma_a, double g, bool env) {
   return "{" + test::camera_json() + R"(,
     "media": [{"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1}, "sigma_s": )" +
          std::to_string(sigma_s) + R"(, "sigma_a": )" + std::to_string(sigma_a) +
@@ -84,7 +84,7 @@ std::string sphere_scene(double sigma_s, double sigma_a, double g, bool env) {
 
 // Mean radiance over a few camera rays.
 template <typename I>
-Rgb mean_radiance(const I& integrator, int n) {
+Rgb mfs_mean_radiance(const I& integrator, int n) {
   Rgb sum(0.0);
   int count = 0;
   for (const Vec3& d : {Vec3(0, 1, 0), normalize(Vec3(0.1, 1, 0.05)), normalize(Vec3(-0.15, 1, -0.12))}) {
@@ -99,7 +99,7 @@ Rgb mean_radiance(const I& integrator, int n) {
 
 // (Without an environment: mfs carries the environment's light in its scatter grid at every K.)
 TEST(Mfs, NoPeakAndBeerLambertIsSingleScattering) {
-  const Scene scene = test::scene_from_json(sphere_scene(2.0, 0.1, 0.7, false));
+  const Scene scene = test::scene_from_json(mfs_sphere_scene(2.0, 0.1, 0.7, false));
   const SceneContext ctx(scene);
   MfsSettings ms;
   ms.peak_fraction = 0.0;
@@ -108,43 +108,43 @@ TEST(Mfs, NoPeakAndBeerLambertIsSingleScattering) {
   ms.large_angle_scatters = 1;
   const MfsIntegrator mfs(ctx, ms);
   const SingleScatter single(ctx, SingleSettings{0.05, 1});
-  const Rgb a = mean_radiance(mfs, 400), b = mean_radiance(single, 400);
+  const Rgb a = mfs_mean_radiance(mfs, 400), b = mfs_mean_radiance(single, 400);
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(a[c], b[c], 0.02 * b[c]) << c;
 }
 
 TEST(Mfs, OpticallyThinMediumIsSingleScattering) {
   // Multiple scattering is O(tau) of single scattering: at tau = 0.01 mfs (any split) ~ single.
-  const Scene scene = test::scene_from_json(sphere_scene(0.01, 0.0, 0.85, false));
+  const Scene scene = test::scene_from_json(mfs_sphere_scene(0.01, 0.0, 0.85, false));
   const SceneContext ctx(scene);
   MfsSettings ms;  // auto split, forward light path
   const MfsIntegrator mfs(ctx, ms);
   const SingleScatter single(ctx, SingleSettings{0.05, 1});
-  const Rgb a = mean_radiance(mfs, 200), b = mean_radiance(single, 200);
+  const Rgb a = mfs_mean_radiance(mfs, 200), b = mfs_mean_radiance(single, 200);
   EXPECT_GT(a[0], b[0] * 0.999);  // never less than single scattering
   EXPECT_NEAR(a[0], b[0], 0.04 * b[0]);
 }
 
 TEST(Mfs, MoreThanSingleScatteringInDenseMedia) {
-  const Scene scene = test::scene_from_json(sphere_scene(5.0, 0.05, 0.85, false));
+  const Scene scene = test::scene_from_json(mfs_sphere_scene(5.0, 0.05, 0.85, false));
   const SceneContext ctx(scene);
   const MfsIntegrator mfs(ctx, MfsSettings{});
   const SingleScatter single(ctx, SingleSettings{0.05, 1});
-  EXPECT_GT(mean_radiance(mfs, 50)[0], 1.5 * mean_radiance(single, 50)[0]);
+  EXPECT_GT(mfs_mean_radiance(mfs, 50)[0], 1.5 * mfs_mean_radiance(single, 50)[0]);
 }
 
 TEST(Octave, OneOctaveIsSingleScattering) {
-  const Scene scene = test::scene_from_json(sphere_scene(2.0, 0.1, 0.7, true));
+  const Scene scene = test::scene_from_json(mfs_sphere_scene(2.0, 0.1, 0.7, true));
   const SceneContext ctx(scene);
   OctaveSettings os;
   os.octaves = 1;
   os.tau_step = 0.05;
   const OctaveIntegrator octave(ctx, os);
   const SingleScatter single(ctx, SingleSettings{0.05, 1});
-  const Rgb a = mean_radiance(octave, 400), b = mean_radiance(single, 400);
+  const Rgb a = mfs_mean_radiance(octave, 400), b = mfs_mean_radiance(single, 400);
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(a[c], b[c], 0.03 * b[c]) << c;
   // More octaves add light.
   const OctaveIntegrator four(ctx, OctaveSettings{});
-  EXPECT_GT(mean_radiance(four, 100)[0], 1.2 * a[0]);
+  EXPECT_GT(mfs_mean_radiance(four, 100)[0], 1.2 * a[0]);
 }
 
 TEST(Octave, ScalesEccentricity) {

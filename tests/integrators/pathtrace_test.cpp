@@ -12,6 +12,7 @@
 #include "nimbus/error.h"
 #include "nimbus/render.h"
 #include "scene/lights.h"
+#include "support/estimate.h"
 #include "support/scenes.h"
 #include "support/stats.h"
 
@@ -22,20 +23,7 @@ using test::MeanAccumulator;
 using test::scene_from_json;
 
 // Mean and standard error of each channel of radiance(o, d) over n samples.
-struct ChannelStats {
-  MeanAccumulator c[3];
-};
-ChannelStats estimate(const PathTracer& pt, const Vec3& o, const Vec3& d, int n, uint64_t seed = 1) {
-  ChannelStats s;
-  for (int i = 0; i < n; ++i) {
-    Rng rng(seed, uint64_t(i));
-    const Rgb L = pt.Li({o, d}, rng);
-    for (int k = 0; k < 3; ++k) s.c[k].add(L[k]);
-  }
-  return s;
-}
-
-void expect_within_noise(const ChannelStats& s, const Rgb& exact, double rel_floor = 1e-9) {
+void expect_within_noise(const test::ChannelStats& s, const Rgb& exact, double rel_floor = 1e-9) {
   for (int k = 0; k < 3; ++k) {
     const double tol = 5.0 * s.c[k].stderr_mean() + rel_floor * std::abs(exact[k]) + 1e-12;
     EXPECT_NEAR(s.c[k].mean, exact[k], tol) << "channel " << k << " stderr " << s.c[k].stderr_mean();
@@ -107,7 +95,7 @@ TEST(PathTracer, AbsorbingSlabTransmitsTheEnvironment) {
   const PathTracer pt(ctx, 0);
   const Vec3 o(0, -3, 0), d = normalize(Vec3(0.2, 1, 0.1));
   const double chord = 1.0 / d.y;
-  const auto s = estimate(pt, o, d, 20000);
+  const auto s = test::estimate_li(pt, o, d, 20000);
   expect_within_noise(
       s, Rgb(1 * std::exp(-0.3 * chord), 2 * std::exp(-1.0 * chord), 3 * std::exp(-2.5 * chord)));
 }
@@ -124,7 +112,7 @@ TEST(PathTracer, WhiteFurnaceShowsTheEnvironment) {
   const SceneContext ctx(scene);
   const PathTracer pt(ctx, 0);
   for (const Vec3& d : {Vec3(0, 1, 0), normalize(Vec3(0.15, 1, -0.1))}) {
-    const auto s = estimate(pt, Vec3(0, -4, 0), d, 20000);
+    const auto s = test::estimate_li(pt, Vec3(0, -4, 0), d, 20000);
     expect_within_noise(s, Rgb(0.5, 1.0, 2.0));
     for (int k = 0; k < 3; ++k) EXPECT_LT(s.c[k].stderr_mean(), 0.05 * 2.0);
   }
@@ -140,7 +128,7 @@ TEST(PathTracer, TruncatedEventsApproachTheFurnaceFromBelow) {
   double previous = 0.0;
   for (int k : {1, 2, 4, 8}) {
     const PathTracer pt(ctx, k);
-    const auto s = estimate(pt, Vec3(0, -4, 0), Vec3(0, 1, 0), 20000);
+    const auto s = test::estimate_li(pt, Vec3(0, -4, 0), Vec3(0, 1, 0), 20000);
     EXPECT_LT(s.c[0].mean, 1.0 - 3 * s.c[0].stderr_mean());
     EXPECT_GT(s.c[0].mean, previous + 3 * s.c[0].stderr_mean()) << "max_events " << k;
     previous = s.c[0].mean;
@@ -162,21 +150,22 @@ TEST(PathTracer, WideScatterLimitPartitionsTheRadiance) {
     PathTraceSettings wide;
     wide.max_wide_scatters = K;
     wide.peak_fraction = 0.0;
-    const auto a = estimate(PathTracer(ctx, 0, wide), o, d, n), b = estimate(PathTracer(ctx, K), o, d, n, 2);
+    const auto a = test::estimate_li(PathTracer(ctx, 0, wide), o, d, n),
+               b = test::estimate_li(PathTracer(ctx, K), o, d, n, 2);
     const double tol = 5.0 * std::hypot(a.c[0].stderr_mean(), b.c[0].stderr_mean());
     EXPECT_NEAR(a.c[0].mean, b.c[0].mean, tol) << K;
   }
   PathTraceSettings all;
   all.max_wide_scatters = 1 << 20;
-  const auto full = estimate(PathTracer(ctx, 0), o, d, n, 3),
-             limited = estimate(PathTracer(ctx, 0, all), o, d, n, 4);
+  const auto full = test::estimate_li(PathTracer(ctx, 0), o, d, n, 3),
+             limited = test::estimate_li(PathTracer(ctx, 0, all), o, d, n, 4);
   EXPECT_NEAR(full.c[0].mean, limited.c[0].mean,
               5.0 * std::hypot(full.c[0].stderr_mean(), limited.c[0].stderr_mean()));
   double previous = 0.0;
   for (int K : {0, 1, 2, 4}) {
     PathTraceSettings w;
     w.max_wide_scatters = K;  // auto split (f = g^2)
-    const auto s = estimate(PathTracer(ctx, 0, w), o, d, n, 5);
+    const auto s = test::estimate_li(PathTracer(ctx, 0, w), o, d, n, 5);
     EXPECT_GT(s.c[0].mean, previous) << K;
     EXPECT_LT(s.c[0].mean, full.c[0].mean + 5.0 * full.c[0].stderr_mean()) << K;
     previous = s.c[0].mean;
@@ -223,7 +212,7 @@ TEST(PathTracer, SingleScatteringMatchesQuadrature) {
   for (const Vec3& d : {Vec3(0, 1, 0), normalize(Vec3(0.2, 1, 0.15)), normalize(Vec3(-0.1, 1, -0.12))}) {
     const Vec3 o(0, -4, 0);
     const double exact = single_scatter_quadrature(o, d, 1.0, 2.0, 2.05, HgPhase{0.6}, light_dir, 3.0);
-    const auto s = estimate(pt, o, d, 40000);
+    const auto s = test::estimate_li(pt, o, d, 40000);
     expect_within_noise(s, Rgb(exact), 1e-3);
     EXPECT_LT(s.c[0].stderr_mean(), 0.03 * exact);
   }
@@ -239,8 +228,8 @@ TEST(PathTracer, SmallSunDiscMatchesDeltaSun) {
   const Scene disc = scene_from_json(base + "0.53}]}");
   const SceneContext c1(delta), c2(disc);
   const PathTracer p1(c1, 1), p2(c2, 1);
-  const auto s1 = estimate(p1, Vec3(0, -4, 0), Vec3(0, 1, 0), 30000, 5);
-  const auto s2 = estimate(p2, Vec3(0, -4, 0), Vec3(0, 1, 0), 30000, 6);
+  const auto s1 = test::estimate_li(p1, Vec3(0, -4, 0), Vec3(0, 1, 0), 30000, 5);
+  const auto s2 = test::estimate_li(p2, Vec3(0, -4, 0), Vec3(0, 1, 0), 30000, 6);
   const double tol = 5 * std::hypot(s1.c[0].stderr_mean(), s2.c[0].stderr_mean());
   EXPECT_NEAR(s1.c[0].mean, s2.c[0].mean, tol);
 }
@@ -266,7 +255,7 @@ TEST(PathTracer, PointLightSingleScatteringMatchesQuadrature) {
              std::exp(-1.2 * exit_distance(p, w, 1.0));
   }
   exact *= (t1 - t0) / n;
-  expect_within_noise(estimate(pt, o, d, 40000), Rgb(exact), 1e-3);
+  expect_within_noise(test::estimate_li(pt, o, d, 40000), Rgb(exact), 1e-3);
 }
 
 // The majorant grid against one global majorant (the naive tracker): same mean.
@@ -284,8 +273,8 @@ TEST(PathTracer, MajorantGridAgreesWithGlobalMajorant) {
   global_ctx.analytic = AnalyticMedia();
   const PathTracer a(grid_ctx, 0), b(global_ctx, 0);
   for (const Vec3& d : {Vec3(0, 1, 0), normalize(Vec3(0.25, 1, 0.05))}) {
-    const auto sa = estimate(a, Vec3(0, -4, 0), d, 20000, 1);
-    const auto sb = estimate(b, Vec3(0, -4, 0), d, 20000, 2);
+    const auto sa = test::estimate_li(a, Vec3(0, -4, 0), d, 20000, 1);
+    const auto sb = test::estimate_li(b, Vec3(0, -4, 0), d, 20000, 2);
     for (int k = 0; k < 3; ++k) {
       EXPECT_NEAR(sa.c[k].mean, sb.c[k].mean, 5 * std::hypot(sa.c[k].stderr_mean(), sb.c[k].stderr_mean()));
     }
@@ -307,8 +296,8 @@ TEST(PathTracer, AnalyticMediaAgreeWithGlobalMajorant) {
   global_ctx.analytic = AnalyticMedia();
   const PathTracer a(analytic_ctx, 0), b(global_ctx, 0);
   for (const Vec3& d : {Vec3(0, 1, 0), normalize(Vec3(0.25, 1, 0.05)), normalize(Vec3(-0.1, 1, 0.12))}) {
-    const auto sa = estimate(a, Vec3(0, -4, 0), d, 20000, 3);
-    const auto sb = estimate(b, Vec3(0, -4, 0), d, 20000, 4);
+    const auto sa = test::estimate_li(a, Vec3(0, -4, 0), d, 20000, 3);
+    const auto sb = test::estimate_li(b, Vec3(0, -4, 0), d, 20000, 4);
     for (int k = 0; k < 3; ++k) {
       EXPECT_NEAR(sa.c[k].mean, sb.c[k].mean, 5 * std::hypot(sa.c[k].stderr_mean(), sb.c[k].stderr_mean()));
       EXPECT_LT(sa.c[k].stderr_mean(), sb.c[k].stderr_mean()) << "channel " << k;

@@ -20,7 +20,7 @@
 namespace nimbus {
 namespace {
 
-std::string error_of(const std::function<void()>& f) {
+std::string registry_error(const std::function<void()>& f) {
   try {
     f();
   } catch (const Error& e) {
@@ -88,15 +88,15 @@ TEST(Registry, DefaultsAreWrittenOut) {
 }
 
 TEST(Registry, UnknownFieldsAndNamesAreErrors) {
-  EXPECT_EQ(error_of([] {
+  EXPECT_EQ(registry_error([] {
               validate_integrator_options("pathtrace", {{"tau_step", 0.1}}, "s.json");
             }),
             "s.json: /integrator/tau_step: unknown field (known here: max_wide_scatters, peak_fraction)");
-  EXPECT_EQ(error_of([] {
+  EXPECT_EQ(registry_error([] {
               validate_integrator_options("single", {{"transmittance", "exact"}}, "s.json");
             }),
             "s.json: /integrator/transmittance: must be \"ratio\" or \"shadow_map\"");
-  EXPECT_EQ(error_of([] { find_integrator("volpath"); }),
+  EXPECT_EQ(registry_error([] { find_integrator("volpath"); }),
             "unknown integrator 'volpath' (known: pathtrace, single, mfs, octave)");
   std::vector<std::string> names;
   for (const IntegratorEntry& e : integrator_registry()) {

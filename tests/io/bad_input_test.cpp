@@ -24,8 +24,8 @@ namespace nimbus {
 namespace {
 
 // A sphere of radius 1 at the origin (albedo ~0.95, forward scattering), sun, sky and a point light.
-std::string sphere_scene(const std::string& camera_pos, const std::string& point_pos,
-                         const std::string& integrator) {
+std::string bad_input_sphere_scene(const std::string& camera_pos, const std::string& point_pos,
+                                   const std::string& integrator) {
   return fmt::format(R"({{"camera": {{"position": {}, "look_at": [0, 1, 0], "up": [0, 0, 1], "fov_y_deg": 60,
       "width": 8, "height": 8}},
     "media": [{{"shape": {{"type": "sphere", "center": [0, 0, 0], "radius": 1}}, "sigma_s": 3.0,
@@ -49,7 +49,7 @@ void expect_finite_and_lit(const std::string& json, const std::string& what) {
   EXPECT_GT(sum, 0.0) << what;
 }
 
-std::string parse_error(const nlohmann::json& doc) {
+std::string bad_input_parse_error(const nlohmann::json& doc) {
   try {
     parse_scene(doc, "scene.json", ".");
   } catch (const Error& e) {
@@ -66,12 +66,14 @@ nlohmann::json small_scene() {
 
 TEST(BadInput, CameraInsideAMediumRendersWithEveryIntegrator) {
   for (const std::string& name : integrator_names())
-    expect_finite_and_lit(sphere_scene("[0, -0.3, 0.1]", "[0, 0, 3]", name), "camera inside, " + name);
+    expect_finite_and_lit(bad_input_sphere_scene("[0, -0.3, 0.1]", "[0, 0, 3]", name),
+                          "camera inside, " + name);
 }
 
 TEST(BadInput, LightInsideAMediumRendersWithEveryIntegrator) {
   for (const std::string& name : integrator_names())
-    expect_finite_and_lit(sphere_scene("[0, -4, 0]", "[0.1, 0.2, 0.3]", name), "point light inside, " + name);
+    expect_finite_and_lit(bad_input_sphere_scene("[0, -4, 0]", "[0.1, 0.2, 0.3]", name),
+                          "point light inside, " + name);
 }
 
 TEST(BadInput, NoMediaShowsTheEnvironmentWithEveryIntegrator) {
@@ -94,9 +96,9 @@ TEST(BadInput, NoMediaShowsTheEnvironmentWithEveryIntegrator) {
 TEST(BadInput, SppAboveTheLimitNamesTheField) {
   nlohmann::json doc = small_scene();
   doc["integrator"] = {{"spp", kMaxSpp + 1}};
-  EXPECT_EQ(parse_error(doc), fmt::format("scene.json: /integrator/spp: must be <= {}", kMaxSpp));
+  EXPECT_EQ(bad_input_parse_error(doc), fmt::format("scene.json: /integrator/spp: must be <= {}", kMaxSpp));
   doc["integrator"]["spp"] = 1e30;
-  EXPECT_EQ(parse_error(doc), fmt::format("scene.json: /integrator/spp: must be <= {}", kMaxSpp));
+  EXPECT_EQ(bad_input_parse_error(doc), fmt::format("scene.json: /integrator/spp: must be <= {}", kMaxSpp));
   // The RenderOptions override (what --spp sets) is checked by render() too.
   doc["integrator"]["spp"] = 1;
   RenderOptions opt;
@@ -125,9 +127,9 @@ TEST(BadInput, SppAboveTheLimitNamesTheField) {
 TEST(BadInput, MoreThanSixteenMediaIsAParseError) {
   nlohmann::json doc = small_scene();
   for (int i = 0; i < 16; ++i) doc["media"].push_back(doc["media"][0]);
-  EXPECT_EQ(parse_error(doc), "scene.json: /media: at most 16 media (got 17)");
+  EXPECT_EQ(bad_input_parse_error(doc), "scene.json: /media: at most 16 media (got 17)");
   doc["media"].erase(doc["media"].begin());
-  EXPECT_EQ(parse_error(doc), "(no error)");
+  EXPECT_EQ(bad_input_parse_error(doc), "(no error)");
 }
 
 TEST(BadInput, GridsWithoutActiveVoxelsAreErrors) {
@@ -145,12 +147,12 @@ TEST(BadInput, GridsWithoutActiveVoxelsAreErrors) {
   // Through a scene: the error names the scene, the field and the volume file.
   nlohmann::json doc = small_scene();
   doc["media"][0]["shape"] = {{"type", "vdb"}, {"file", (dir / "empty.nvdb").string()}, {"scale", 1.0}};
-  const std::string msg = parse_error(doc);
+  const std::string msg = bad_input_parse_error(doc);
   EXPECT_EQ(msg.rfind("scene.json: /media/0/shape/file: " + (dir / "empty.nvdb").string() + ": ", 0), 0u)
       << msg;
   // A procedural cloud has at least 8 voxels along each axis.
   doc["media"][0]["shape"] = {{"type", "cloud"}, {"radius", 1}, {"resolution", 0}};
-  EXPECT_EQ(parse_error(doc), "scene.json: /media/0/shape/resolution: must be >= 8");
+  EXPECT_EQ(bad_input_parse_error(doc), "scene.json: /media/0/shape/resolution: must be >= 8");
 }
 
 // A scene may name any path as a volume: devices, FIFOs and directories are refused from their file
@@ -167,27 +169,28 @@ TEST(BadInput, VolumePathsThatAreNotRegularFilesAreRefusedWithoutOpening) {
   for (const auto& [path, what] : cases) {
     nlohmann::json doc = small_scene();
     doc["media"][0]["shape"] = {{"type", "vdb"}, {"file", path}, {"scale", 1.0}};
-    EXPECT_EQ(parse_error(doc).rfind("scene.json: /media/0/shape/file: " + path + ": " + what, 0), 0u)
-        << parse_error(doc);
+    EXPECT_EQ(bad_input_parse_error(doc).rfind("scene.json: /media/0/shape/file: " + path + ": " + what, 0),
+              0u)
+        << bad_input_parse_error(doc);
   }
 }
 
 TEST(BadInput, DegenerateCameraFramesAreErrors) {
   nlohmann::json doc = small_scene();
   doc["camera"]["look_at"] = doc["camera"]["position"];
-  EXPECT_EQ(parse_error(doc), "scene.json: /camera/look_at: must differ from position");
+  EXPECT_EQ(bad_input_parse_error(doc), "scene.json: /camera/look_at: must differ from position");
   doc = small_scene();
   const std::string parallel =
       "scene.json: /camera/up: must not be parallel to the view direction (look_at - position)";
   for (const auto& up :
        {nlohmann::json{0, -3, 0}, nlohmann::json{0, 1, 1e-9}}) {  // anti-parallel, nearly parallel
     doc["camera"]["up"] = up;
-    EXPECT_EQ(parse_error(doc), parallel) << up;
+    EXPECT_EQ(bad_input_parse_error(doc), parallel) << up;
   }
   doc["camera"]["up"] = {0, 0, 0};
-  EXPECT_EQ(parse_error(doc), "scene.json: /camera/up: must have non-zero length");
+  EXPECT_EQ(bad_input_parse_error(doc), "scene.json: /camera/up: must have non-zero length");
   doc["camera"]["up"] = {0, 1, 0.01};  // nearly, but not quite, parallel: a valid (tilted) frame
-  EXPECT_EQ(parse_error(doc), "(no error)");
+  EXPECT_EQ(bad_input_parse_error(doc), "(no error)");
 }
 
 }  // namespace

@@ -11,7 +11,7 @@ std::string with_film(const std::string& film) {
   return "{" + test::camera_json() + R"(, "media": [], "lights": [], "film": )" + film + "}";
 }
 
-std::string error_of(const std::string& film) {
+std::string film_error(const std::string& film) {
   try {
     test::scene_from_json(with_film(film));
   } catch (const Error& e) {
@@ -31,20 +31,20 @@ TEST(FilmJson, ParsesTransparencyAndLayers) {
 }
 
 TEST(FilmJson, BadFieldsAreErrorsNamingThePath) {
-  EXPECT_EQ(error_of(R"({"transparent": 1})"),
+  EXPECT_EQ(film_error(R"({"transparent": 1})"),
             "test.json: /film/transparent: must be true or false, not a number");
-  EXPECT_EQ(error_of(R"({"layers": "depth"})"), "test.json: /film/layers: must be an array of layer names");
-  EXPECT_EQ(error_of(R"({"layers": ["depth", 3]})"),
+  EXPECT_EQ(film_error(R"({"layers": "depth"})"), "test.json: /film/layers: must be an array of layer names");
+  EXPECT_EQ(film_error(R"({"layers": ["depth", 3]})"),
             "test.json: /film/layers/1: must be a layer name (a string)");
   EXPECT_EQ(
-      error_of(R"({"layers": ["depth", "zdepth"]})"),
+      film_error(R"({"layers": ["depth", "zdepth"]})"),
       "test.json: /film/layers/1: unknown layer 'zdepth' (known: depth, transmittance, direct, indirect, "
       "albedo, normal, samples)");
-  EXPECT_EQ(error_of(R"({"layers": ["depth", "depth"]})"),
+  EXPECT_EQ(film_error(R"({"layers": ["depth", "depth"]})"),
             "test.json: /film/layers/1: layer 'depth' named twice");
-  EXPECT_EQ(error_of(R"({"transparant": true})"),
+  EXPECT_EQ(film_error(R"({"transparant": true})"),
             "test.json: /film/transparant: unknown field (known here: transparent)");
-  EXPECT_EQ(error_of("[]"), "test.json: /film: must be an object, not an array");
+  EXPECT_EQ(film_error("[]"), "test.json: /film: must be an object, not an array");
 }
 
 }  // namespace

@@ -49,7 +49,7 @@ std::string mesh_error(const std::string& text) {
   return "(no error)";
 }
 
-std::string load_error(const fs::path& file, const std::string& name) {
+std::string mesh_load_error(const fs::path& file, const std::string& name) {
   try {
     load_mesh(file, name);
   } catch (const Error& e) {
@@ -296,18 +296,18 @@ TEST(MeshFiles, LoadsAnObjFile) {
 
 TEST(MeshFiles, UnreadableFilesAreErrorsNamingTheFile) {
   const test::ScratchDir dir("mesh_files");
-  EXPECT_EQ(load_error(dir / "missing.obj", "missing.obj"), "missing.obj: no such file");
+  EXPECT_EQ(mesh_load_error(dir / "missing.obj", "missing.obj"), "missing.obj: no such file");
   fs::create_directories(dir / "folder.obj");
-  EXPECT_EQ(load_error(dir / "folder.obj", "folder.obj"), "folder.obj: is a directory");
+  EXPECT_EQ(mesh_load_error(dir / "folder.obj", "folder.obj"), "folder.obj: is a directory");
   std::ofstream(dir / "cube.ply") << "ply\nformat ascii 1.0\nend_header\n";
-  EXPECT_EQ(load_error(dir / "cube.ply", "cube.ply"),
+  EXPECT_EQ(mesh_load_error(dir / "cube.ply", "cube.ply"),
             "cube.ply: unsupported mesh format '.ply' (supported: .obj)");
-  EXPECT_EQ(load_error(dir / "cube", "cube"), "cube: unsupported mesh format '' (supported: .obj)");
+  EXPECT_EQ(mesh_load_error(dir / "cube", "cube"), "cube: unsupported mesh format '' (supported: .obj)");
   // A FIFO blocked the read until something wrote to it (bug found by this test); devices likewise.
   ASSERT_EQ(::mkfifo((dir / "pipe.obj").c_str(), 0600), 0);
-  EXPECT_EQ(load_error(dir / "pipe.obj", "pipe.obj"), "pipe.obj: not a regular file");
+  EXPECT_EQ(mesh_load_error(dir / "pipe.obj", "pipe.obj"), "pipe.obj: not a regular file");
   std::ofstream(dir / "empty.obj").flush();
-  EXPECT_EQ(load_error(dir / "empty.obj", "empty.obj"), "empty.obj: the mesh has no triangles");
+  EXPECT_EQ(mesh_load_error(dir / "empty.obj", "empty.obj"), "empty.obj: the mesh has no triangles");
   {
     std::ofstream out(dir / "random.obj", std::ios::binary);
     uint32_t x = 12345;
@@ -316,9 +316,9 @@ TEST(MeshFiles, UnreadableFilesAreErrorsNamingTheFile) {
       out.put(char(x >> 24));
     }
   }
-  EXPECT_EQ(load_error(dir / "random.obj", "random.obj").rfind("random.obj: ", 0), 0u);
+  EXPECT_EQ(mesh_load_error(dir / "random.obj", "random.obj").rfind("random.obj: ", 0), 0u);
   std::ofstream(dir / "nan.obj") << triangle_with_vertex("v 0 nan 0");
-  EXPECT_EQ(load_error(dir / "nan.obj", "meshes/nan.obj"),
+  EXPECT_EQ(mesh_load_error(dir / "nan.obj", "meshes/nan.obj"),
             "meshes/nan.obj: line 1: vertex coordinate 'nan' is not finite");
 }
 

@@ -21,7 +21,7 @@ Scene with_light(const std::string& light) {
   return test::scene_from_json("{" + test::camera_json() + R"(, "media": [], "lights": [)" + light + "]}");
 }
 
-std::string error_of(const std::string& light) {
+std::string light_error(const std::string& light) {
   try {
     with_light(light);
   } catch (const Error& e) {
@@ -82,27 +82,27 @@ TEST(SceneLights, BadFieldsAreNamed) {
   const std::string at = "test.json: /lights/0/";
   const std::string spot =
       R"({"type": "spot", "position": [0, 0, 2], "direction": [0, 0, -1], "intensity": 1)";
-  EXPECT_EQ(error_of(spot + R"(, "cone_angle_deg": 0})"), at + "cone_angle_deg: must be > 0");
-  EXPECT_EQ(error_of(spot + R"(, "cone_angle_deg": 200})"), at + "cone_angle_deg: must be <= 180");
-  EXPECT_EQ(error_of(spot + R"(, "cone_angle_deg": 30, "blend": 1.5})"), at + "blend: must be <= 1");
-  EXPECT_EQ(error_of(spot + "}"), at + "cone_angle_deg: required field is missing");
-  EXPECT_EQ(error_of(std::string(kSphere) + R"(, "radiance": -1})"), at + "radiance: must be >= 0");
-  EXPECT_EQ(error_of(std::string(kSphere) + R"(, "radiance": 1, "power": 2})"),
+  EXPECT_EQ(light_error(spot + R"(, "cone_angle_deg": 0})"), at + "cone_angle_deg: must be > 0");
+  EXPECT_EQ(light_error(spot + R"(, "cone_angle_deg": 200})"), at + "cone_angle_deg: must be <= 180");
+  EXPECT_EQ(light_error(spot + R"(, "cone_angle_deg": 30, "blend": 1.5})"), at + "blend: must be <= 1");
+  EXPECT_EQ(light_error(spot + "}"), at + "cone_angle_deg: required field is missing");
+  EXPECT_EQ(light_error(std::string(kSphere) + R"(, "radiance": -1})"), at + "radiance: must be >= 0");
+  EXPECT_EQ(light_error(std::string(kSphere) + R"(, "radiance": 1, "power": 2})"),
             at + "power: give either radiance or power, not both");
-  EXPECT_EQ(error_of(std::string(kSphere) + "}"),
+  EXPECT_EQ(light_error(std::string(kSphere) + "}"),
             "test.json: /lights/0: an area light needs \"radiance\" or \"power\"");
-  EXPECT_EQ(error_of(R"({"type": "sphere", "center": [0, 0, 2], "radius": 0, "radiance": 1})"),
+  EXPECT_EQ(light_error(R"({"type": "sphere", "center": [0, 0, 2], "radius": 0, "radiance": 1})"),
             at + "radius: must be > 0");
-  EXPECT_EQ(error_of(R"({"type": "rectangle", "center": [0, 0, 2], "normal": [0, 0, -1], "up": [0, 1, 0],
+  EXPECT_EQ(light_error(R"({"type": "rectangle", "center": [0, 0, 2], "normal": [0, 0, -1], "up": [0, 1, 0],
       "size": [0, 1], "radiance": 1})"),
             at + "size: both sides must be > 0 and finite");
-  EXPECT_EQ(error_of(R"({"type": "rectangle", "center": [0, 0, 2], "normal": [0, 0, -1], "up": [0, 0, 1],
+  EXPECT_EQ(light_error(R"({"type": "rectangle", "center": [0, 0, 2], "normal": [0, 0, -1], "up": [0, 0, 1],
       "size": [1, 1], "radiance": 1})"),
             at + "up: must not be parallel to the normal");
-  EXPECT_EQ(error_of(std::string(kRect) + R"(, "power": -3})"), at + "power: must be >= 0");
-  EXPECT_EQ(error_of(std::string(kSphere) + R"(, "radiance": 1, "transform": {"scale": [1, 2, 1]}})"),
+  EXPECT_EQ(light_error(std::string(kRect) + R"(, "power": -3})"), at + "power: must be >= 0");
+  EXPECT_EQ(light_error(std::string(kSphere) + R"(, "radiance": 1, "transform": {"scale": [1, 2, 1]}})"),
             at + "transform: must be rotations, one uniform scale and a translation for an area light");
-  EXPECT_EQ(error_of(std::string(kRect) + R"(, "radiance": 1, "visibl": true})").substr(0, at.size() + 14),
+  EXPECT_EQ(light_error(std::string(kRect) + R"(, "radiance": 1, "visibl": true})").substr(0, at.size() + 14),
             at + "visibl: unknow");
 }
 

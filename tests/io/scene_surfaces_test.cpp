@@ -32,7 +32,7 @@ Scene parse_in(const std::string& surfaces, const fs::path& base_dir = ".") {
   return parse_scene(scene_with(surfaces), "scene.json", base_dir);
 }
 
-std::string error_of(const std::string& surfaces, const fs::path& base_dir = ".") {
+std::string surfaces_error(const std::string& surfaces, const fs::path& base_dir = ".") {
   try {
     parse_in(surfaces, base_dir);
   } catch (const Error& e) {
@@ -43,12 +43,12 @@ std::string error_of(const std::string& surfaces, const fs::path& base_dir = "."
 
 // One surface with this shape (and the default material).
 std::string shape_error(const std::string& shape, const fs::path& base_dir = ".") {
-  return error_of(R"([{"shape": )" + shape + "}]", base_dir);
+  return surfaces_error(R"([{"shape": )" + shape + "}]", base_dir);
 }
 
 // One unit sphere with this material.
 std::string material_error(const std::string& material) {
-  return error_of(R"([{"shape": {"type": "sphere", "radius": 1}, "material": )" + material + "}]");
+  return surfaces_error(R"([{"shape": {"type": "sphere", "radius": 1}, "material": )" + material + "}]");
 }
 
 TEST(SceneSurfaces, NoSurfacesByDefault) {
@@ -161,9 +161,9 @@ TEST(SceneSurfacesErrors, BadMeshFilesNameTheSceneThePathAndTheMesh) {
 TEST(SceneSurfacesErrors, TheSurfacesIndexIsInThePath) {
   const test::ScratchDir dir("surfaces_index");
   std::ofstream(dir / "quad.obj") << kQuad;
-  EXPECT_EQ(error_of(R"([{"shape": {"type": "mesh", "file": "quad.obj"}},
+  EXPECT_EQ(surfaces_error(R"([{"shape": {"type": "mesh", "file": "quad.obj"}},
                          {"shape": {"type": "mesh", "file": "sub/gone.obj"}}])",
-                     dir.path),
+                           dir.path),
             "scene.json: /surfaces/1/shape/file: sub/gone.obj: no such file");
 }
 
@@ -237,13 +237,13 @@ TEST(SceneSurfacesErrors, MaterialFields) {
 }
 
 TEST(SceneSurfacesErrors, SurfaceEntries) {
-  EXPECT_EQ(error_of(R"([{"shape": {"type": "sphere", "radius": 1}, "transfrom": {}}])")
+  EXPECT_EQ(surfaces_error(R"([{"shape": {"type": "sphere", "radius": 1}, "transfrom": {}}])")
                 .rfind("scene.json: /surfaces/0/transfrom: unknown field", 0),
             0u);
-  EXPECT_EQ(error_of(R"([{"material": {"type": "holdout"}}])"),
+  EXPECT_EQ(surfaces_error(R"([{"material": {"type": "holdout"}}])"),
             "scene.json: /surfaces/0/shape: required field is missing");
-  EXPECT_EQ(error_of(R"([3])"), "scene.json: /surfaces/0: must be an object, not a number");
-  EXPECT_EQ(error_of(R"({"shape": {}})"), "scene.json: /surfaces: must be an array, not an object");
+  EXPECT_EQ(surfaces_error(R"([3])"), "scene.json: /surfaces/0: must be an object, not a number");
+  EXPECT_EQ(surfaces_error(R"({"shape": {}})"), "scene.json: /surfaces: must be an array, not an object");
 }
 
 }  // namespace

@@ -28,7 +28,7 @@ Transform parse(const std::string& text) {
   return parse_transform(JsonObject(j, "scene.json", "/media/0/transform"));
 }
 
-std::string error_of(const std::string& text) {
+std::string transform_error(const std::string& text) {
   try {
     parse(text);
   } catch (const Error& e) {
@@ -159,37 +159,41 @@ TEST(TransformJson, MatrixFormEqualsTheSrtForm) {
 
 TEST(TransformJson, ErrorsNameTheFileAndThePath) {
   const std::string p = "scene.json: /media/0/transform";
-  EXPECT_EQ(error_of(R"({"scale": 0})"), p + "/scale: must not be zero");
-  EXPECT_EQ(error_of(R"({"scale": [1, 0, 1]})"), p + "/scale/1: must not be zero");
-  EXPECT_EQ(error_of(R"({"scale": "big"})"), p + "/scale: must be a number or an array [sx, sy, sz]");
-  EXPECT_EQ(error_of(R"({"scale": [1, 2]})"), p + "/scale: must be an array of 3 numbers");
-  EXPECT_EQ(error_of(R"({"scale": [1e-200, 1e-200, 1]})"),
+  EXPECT_EQ(transform_error(R"({"scale": 0})"), p + "/scale: must not be zero");
+  EXPECT_EQ(transform_error(R"({"scale": [1, 0, 1]})"), p + "/scale/1: must not be zero");
+  EXPECT_EQ(transform_error(R"({"scale": "big"})"), p + "/scale: must be a number or an array [sx, sy, sz]");
+  EXPECT_EQ(transform_error(R"({"scale": [1, 2]})"), p + "/scale: must be an array of 3 numbers");
+  EXPECT_EQ(transform_error(R"({"scale": [1e-200, 1e-200, 1]})"),
             p + "/scale: must give an invertible transform (components too small or too large)");
-  EXPECT_EQ(error_of(R"({"rotate": [{"axis": [1, 0, 0], "degrees": 5}, {"axis": [0, 0, 0], "degrees": 5}]})"),
+  EXPECT_EQ(transform_error(
+                R"({"rotate": [{"axis": [1, 0, 0], "degrees": 5}, {"axis": [0, 0, 0], "degrees": 5}]})"),
             p + "/rotate/1/axis: must have non-zero length");
-  EXPECT_EQ(error_of(R"({"rotate": [{"axis": [1, 0, 0]}]})"),
+  EXPECT_EQ(transform_error(R"({"rotate": [{"axis": [1, 0, 0]}]})"),
             p + "/rotate/0/degrees: required field is missing");
-  EXPECT_EQ(error_of(R"({"rotate": [{"axis": [1, 0, 0], "degrees": 5, "angle": 1}]})"),
+  EXPECT_EQ(transform_error(R"({"rotate": [{"axis": [1, 0, 0], "degrees": 5, "angle": 1}]})"),
             p + "/rotate/0/angle: unknown field (known here: axis, degrees)");
-  EXPECT_EQ(error_of(R"({"rotate": {"axis": [1, 0, 0], "degrees": 5}})"),
+  EXPECT_EQ(transform_error(R"({"rotate": {"axis": [1, 0, 0], "degrees": 5}})"),
             p + "/rotate: must be an array, not an object");
-  EXPECT_EQ(error_of(R"({"translate": [1, 2, "x"]})"), p + "/translate/2: must be a number, not a string");
-  EXPECT_EQ(error_of(R"({"translation": [1, 2, 3]})"),
+  EXPECT_EQ(transform_error(R"({"translate": [1, 2, "x"]})"),
+            p + "/translate/2: must be a number, not a string");
+  EXPECT_EQ(transform_error(R"({"translation": [1, 2, 3]})"),
             p + "/translation: unknown field (known here: matrix, rotate, scale, translate)");
   // The matrix form.
-  EXPECT_EQ(error_of(R"({"matrix": [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 1, 1]]})"),
+  EXPECT_EQ(transform_error(R"({"matrix": [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 1, 1]]})"),
             p + "/matrix/3: must be [0, 0, 0, 1] (an affine map)");
-  EXPECT_EQ(error_of(R"({"matrix": [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0]]})"),
+  EXPECT_EQ(transform_error(R"({"matrix": [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0]]})"),
             p + "/matrix: must be an array of 4 rows of 4 numbers");
-  EXPECT_EQ(error_of(R"({"matrix": [[1, 0, 0, 0], [0, 1, 0], [0, 0, 1, 0], [0, 0, 0, 1]]})"),
+  EXPECT_EQ(transform_error(R"({"matrix": [[1, 0, 0, 0], [0, 1, 0], [0, 0, 1, 0], [0, 0, 0, 1]]})"),
             p + "/matrix/1: must be an array of 4 numbers");
-  EXPECT_EQ(error_of(R"({"matrix": [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, null, 0], [0, 0, 0, 1]]})"),
+  EXPECT_EQ(transform_error(R"({"matrix": [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, null, 0], [0, 0, 0, 1]]})"),
             p + "/matrix/2/2: must be a number");
-  EXPECT_EQ(error_of(R"({"matrix": [[1, 2, 3, 0], [2, 4, 6, 0], [0, 0, 1, 0], [0, 0, 0, 1]]})"),
+  EXPECT_EQ(transform_error(R"({"matrix": [[1, 2, 3, 0], [2, 4, 6, 0], [0, 0, 1, 0], [0, 0, 0, 1]]})"),
             p + "/matrix: must be finite and invertible (determinant 0)");
-  EXPECT_EQ(error_of(R"({"matrix": [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]], "scale": 2})"),
-            p + "/scale: cannot be combined with \"matrix\" (use one form or the other)");
-  EXPECT_EQ(error_of(R"({"matrix": [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]], "rotate": []})"),
+  EXPECT_EQ(
+      transform_error(R"({"matrix": [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]], "scale": 2})"),
+      p + "/scale: cannot be combined with \"matrix\" (use one form or the other)");
+  EXPECT_EQ(transform_error(
+                R"({"matrix": [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]], "rotate": []})"),
             p + "/rotate: cannot be combined with \"matrix\" (use one form or the other)");
   // NaN cannot be written in JSON text, but a document built in memory can hold it.
   nlohmann::json nan_doc = nlohmann::json::parse(R"({"rotate": [{"axis": [1, 0, 0], "degrees": 0}]})");

@@ -26,7 +26,7 @@ namespace {
 struct Params {
   double n, mu;
 };
-const Params kCases[] = {{1.10, 3.5835}, {1.05, 3.3}, {1.2, 4.5}, {1.3184, 5.0}};
+const Params kFfCases[] = {{1.10, 3.5835}, {1.05, 3.3}, {1.2, 4.5}, {1.3184, 5.0}};
 
 // Mobley, Sundman & Boss 2002, eq. 5, as printed (no care for delta = 1).
 double ff_naive(double psi, double n, double mu) {
@@ -55,7 +55,7 @@ double quad(double theta, double mu, const std::function<double(double)>& f) {
 }
 
 TEST(FournierForand, EvaluationMatchesThePrintedForm) {
-  for (const Params& p : kCases) {
+  for (const Params& p : kFfCases) {
     const double K = 4.0 / (3.0 * (p.n - 1.0) * (p.n - 1.0));
     for (double psi = 1e-4; psi < kPi; psi *= 1.01) {
       const double delta = K * std::pow(std::sin(psi / 2.0), 2);
@@ -73,7 +73,7 @@ TEST(FournierForand, EvaluationMatchesThePrintedForm) {
 }
 
 TEST(FournierForand, NormalisedCdfAndBackscatterAgainstQuadrature) {
-  for (const Params& p : kCases) {
+  for (const Params& p : kFfCases) {
     auto P = [&](double psi) { return ff_eval_theta(psi, p.n, p.mu); };
     EXPECT_NEAR(quad(kPi, p.mu, P), 1.0, 1e-7) << p.n << " " << p.mu;
     for (double th : {1e-4, 1e-2, 0.1, 0.5, 0.5 * kPi, 2.5})
@@ -96,7 +96,7 @@ TEST(FournierForand, NormalisedCdfAndBackscatterAgainstQuadrature) {
 }
 
 TEST(FournierForand, TableMatchesTheClosedForm) {
-  for (const Params& p : kCases) {
+  for (const Params& p : kFfCases) {
     const TabulatedPhase t = make_ff_phase(p.n, p.mu);
     // The table's CDF at its nodes against the closed form.
     double worst = 0.0;

@@ -14,7 +14,7 @@ namespace nimbus {
 namespace {
 
 // Integral over the sphere of p(cos theta) by midpoint rule in theta, refined near the forward peak.
-double sphere_integral(const Phase& p, double weight_power = 0.0) {
+double phase_sphere_integral(const Phase& p, double weight_power = 0.0) {
   double sum = 0.0;
   const int n = 400000;
   for (int i = 0; i < n; ++i) {
@@ -47,13 +47,13 @@ std::vector<Phase> all_phases() {
 
 TEST(Phase, NormalisedOnTheSphere) {
   for (const Phase& p : all_phases()) {
-    EXPECT_NEAR(sphere_integral(p), 1.0, 2e-4) << phase_describe(p);
+    EXPECT_NEAR(phase_sphere_integral(p), 1.0, 2e-4) << phase_describe(p);
   }
 }
 
 TEST(Phase, MeanCosineMatchesQuadrature) {
   for (const Phase& p : all_phases()) {
-    EXPECT_NEAR(phase_mean_cosine(p), sphere_integral(p, 1.0), 2e-4) << phase_describe(p);
+    EXPECT_NEAR(phase_mean_cosine(p), phase_sphere_integral(p, 1.0), 2e-4) << phase_describe(p);
   }
 }
 

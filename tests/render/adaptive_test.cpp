@@ -13,6 +13,7 @@
 #include "nimbus/error.h"
 #include "nimbus/render.h"
 #include "render/film.h"
+#include "support/bitwise.h"
 #include "support/scenes.h"
 
 namespace nimbus {
@@ -101,7 +102,7 @@ TEST(Adaptive, CostlierPixelsTakeFewerSamples) {
   EXPECT_NEAR(double(plan.target[12 + 2]) / double(plan.target[12 + 9]), 2.0, 0.05);
 }
 
-Scene sphere_scene(int spp) {
+Scene adaptive_sphere_scene(int spp) {
   return test::scene_from_json("{" + test::camera_json(24, 20) + R"(,
     "media": [{"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 0.8}, "sigma_s": 6.0,
                "sigma_a": 0.3, "phase": {"type": "hg", "g": 0.7}}],
@@ -118,7 +119,7 @@ const ImageChannel& samples_channel(const Image& img) {
 }
 
 TEST(Adaptive, ReachesItsTargetAndSpendsSamplesOnTheMedium) {
-  const Scene scene = sphere_scene(1024);
+  const Scene scene = adaptive_sphere_scene(1024);
   RenderOptions o;
   o.noise = 0.05;
   o.threads = 2;
@@ -149,12 +150,8 @@ TEST(Adaptive, ReachesItsTargetAndSpendsSamplesOnTheMedium) {
   EXPECT_LT(truth, 2.0 * r.noise_estimate);
 }
 
-bool same_floats(const std::vector<float>& a, const std::vector<float>& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0;
-}
-
 TEST(Adaptive, BitIdenticalForAnyThreadCountAndWhenResumed) {
-  const Scene scene = sphere_scene(256);
+  const Scene scene = adaptive_sphere_scene(256);
   RenderOptions one;
   one.noise = 0.08;
   one.threads = 1;
@@ -162,7 +159,7 @@ TEST(Adaptive, BitIdenticalForAnyThreadCountAndWhenResumed) {
   RenderOptions two = one;
   two.threads = 2;
   two.tile_size = 5;
-  EXPECT_TRUE(same_floats(whole.image.rgb, render(scene, two).image.rgb));
+  EXPECT_TRUE(test::same_floats(whole.image.rgb, render(scene, two).image.rgb));
   // Cancelled part-way through a later pass: the film of the last whole pass; resumed with the same
   // target, the render made in one go.
   std::atomic<bool> cancel{false};
@@ -177,8 +174,8 @@ TEST(Adaptive, BitIdenticalForAnyThreadCountAndWhenResumed) {
   RenderOptions rest = two;
   rest.resume = &part.state;
   const RenderResult resumed = render(scene, rest);
-  EXPECT_TRUE(same_floats(whole.image.rgb, resumed.image.rgb));
-  EXPECT_FALSE(same_floats(part.image.rgb, resumed.image.rgb));
+  EXPECT_TRUE(test::same_floats(whole.image.rgb, resumed.image.rgb));
+  EXPECT_FALSE(test::same_floats(part.image.rgb, resumed.image.rgb));
   // A render made without a noise target cannot be continued adaptively.
   RenderOptions plain;
   plain.spp = 4;

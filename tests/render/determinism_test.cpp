@@ -27,7 +27,7 @@ std::string scene_json(const std::string& integrator_block) {
          integrator_block + "}";
 }
 
-RenderResult render_with(const Scene& scene, int threads) {
+RenderResult render_determinism(const Scene& scene, int threads) {
   RenderOptions opt;
   opt.threads = threads;
   opt.tile_size = 4;
@@ -42,14 +42,14 @@ void expect_identical(const RenderResult& a, const RenderResult& b, const std::s
 
 void check_deterministic(const std::string& name, const std::string& integrator_block) {
   const Scene scene = test::scene_from_json(scene_json(integrator_block));
-  const RenderResult one = render_with(scene, 1);
+  const RenderResult one = render_determinism(scene, 1);
   ASSERT_FALSE(one.partial) << name;
   double sum = 0;
   for (float v : one.image.rgb) sum += v;
   EXPECT_GT(sum, 0.0) << name << ": the scene must not render black";
-  expect_identical(one, render_with(scene, 2), name + ": 1 vs 2 threads");
-  expect_identical(one, render_with(scene, 4), name + ": 1 vs 4 threads");
-  const RenderResult two_a = render_with(scene, 2), two_b = render_with(scene, 2);
+  expect_identical(one, render_determinism(scene, 2), name + ": 1 vs 2 threads");
+  expect_identical(one, render_determinism(scene, 4), name + ": 1 vs 4 threads");
+  const RenderResult two_a = render_determinism(scene, 2), two_b = render_determinism(scene, 2);
   expect_identical(two_a, two_b, name + ": 2 threads, twice");
 }
 

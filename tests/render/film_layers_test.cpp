@@ -28,7 +28,7 @@ nlohmann::json fine_options(const std::string& type) {
   return nlohmann::json::object();
 }
 
-std::string sphere_scene(double sigma_s, double sigma_a, const std::string& lights) {
+std::string layers_sphere_scene(double sigma_s, double sigma_a, const std::string& lights) {
   return "{" + test::camera_json(8, 8) + R"(, "media": [{"shape": {"type": "sphere", "center": [0, 0, 0],
     "radius": 1}, "sigma_s": )" +
          std::to_string(sigma_s) + R"(, "sigma_a": )" + std::to_string(sigma_a) +
@@ -52,7 +52,7 @@ test::MeanAccumulator alpha_of(const Integrator& integrator, const Ray& ray, int
 
 TEST(FilmLayers, AlphaOfAHomogeneousSphereIsOneMinusItsTransmittance) {
   const double sigma_s = 1.2, sigma_a = 0.3, sigma_t = sigma_s + sigma_a;
-  const Scene scene = test::scene_from_json(sphere_scene(sigma_s, sigma_a, kSun));
+  const Scene scene = test::scene_from_json(layers_sphere_scene(sigma_s, sigma_a, kSun));
   const SceneContext ctx(scene);
   const Vec3 o(0, -5, 0);
   for (const char* type : kIntegrators) {
@@ -120,7 +120,7 @@ TEST(FilmLayers, HalfTransmittanceFractionSolvesTheStep) {
 }
 
 TEST(FilmLayers, DirectIsTheUnscatteredAndSingleScatteredLight) {
-  const Scene scene = test::scene_from_json(sphere_scene(1.5, 0.2, kSun + ", " + kSky));
+  const Scene scene = test::scene_from_json(layers_sphere_scene(1.5, 0.2, kSun + ", " + kSky));
   const SceneContext ctx(scene);
   const Ray ray{Vec3(0, -5, 0), normalize(Vec3(0.1, 5, 0.2))};
   auto make = [&](const std::string& type, nlohmann::json options, int max_events = 0) {
@@ -168,7 +168,7 @@ TEST(FilmLayers, DirectIsTheUnscatteredAndSingleScatteredLight) {
 }
 
 TEST(FilmLayers, MfsDirectIsEverythingWithoutTheScatterGrid) {
-  const Scene scene = test::scene_from_json(sphere_scene(1.5, 0.2, kSun));
+  const Scene scene = test::scene_from_json(layers_sphere_scene(1.5, 0.2, kSun));
   const SceneContext ctx(scene);
   IntegratorSettings settings;
   settings.type = "mfs";
@@ -181,7 +181,8 @@ TEST(FilmLayers, MfsDirectIsEverythingWithoutTheScatterGrid) {
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(s.direct[c], L[c], 1e-12);
 }
 
-RenderResult render_with(const std::string& text, const std::string& type, const nlohmann::json& film) {
+RenderResult render_layers_with(const std::string& text, const std::string& type,
+                                const nlohmann::json& film) {
   nlohmann::json doc = nlohmann::json::parse(text);
   doc["integrator"] = {{"type", type}, {"spp", 4}, {"seed", 5}};
   if (!film.is_null()) doc["film"] = film;
@@ -197,12 +198,12 @@ const ImageChannel* channel(const Image& image, const std::string& name) {
 }
 
 TEST(FilmLayers, TransparentFilmLeavesTheEnvironmentOut) {
-  const std::string text = sphere_scene(2.0, 0.2, kSun + ", " + kSky);
+  const std::string text = layers_sphere_scene(2.0, 0.2, kSun + ", " + kSky);
   const Rgb sky(0.1, 0.2, 0.4);
   for (const char* type : {"single", "pathtrace"}) {
-    const RenderResult opaque = render_with(text, type, nullptr);
+    const RenderResult opaque = render_layers_with(text, type, nullptr);
     const RenderResult clear =
-        render_with(text, type, {{"transparent", true}, {"layers", {"transmittance"}}});
+        render_layers_with(text, type, {{"transparent", true}, {"layers", {"transmittance"}}});
     const ImageChannel* tr[3] = {channel(clear.image, "transmittance.R"),
                                  channel(clear.image, "transmittance.G"),
                                  channel(clear.image, "transmittance.B")};
@@ -226,8 +227,8 @@ TEST(FilmLayers, TransparentFilmLeavesTheEnvironmentOut) {
 }
 
 TEST(FilmLayers, LayersBecomeNamedChannels) {
-  const std::string text = sphere_scene(2.0, 0.2, kSun + ", " + kSky);
-  const RenderResult r = render_with(text, "single", {{"layers", film_layer_names()}});
+  const std::string text = layers_sphere_scene(2.0, 0.2, kSun + ", " + kSky);
+  const RenderResult r = render_layers_with(text, "single", {{"layers", film_layer_names()}});
   std::vector<std::string> names;
   for (const ImageChannel& c : r.image.channels) names.push_back(c.name);
   const std::vector<std::string> expected = {
@@ -243,7 +244,7 @@ TEST(FilmLayers, LayersBecomeNamedChannels) {
   EXPECT_GT(z, 4.0f);
   EXPECT_LT(z, 5.0f);
   // Without layers the image is RGBA only.
-  EXPECT_TRUE(render_with(text, "single", nullptr).image.channels.empty());
+  EXPECT_TRUE(render_layers_with(text, "single", nullptr).image.channels.empty());
 }
 
 TEST(FilmLayers, UnknownOrRepeatedLayersAreErrors) {

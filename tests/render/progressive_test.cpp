@@ -9,6 +9,7 @@
 #include "nimbus/error.h"
 #include "nimbus/image.h"
 #include "nimbus/render.h"
+#include "support/bitwise.h"
 #include "support/scenes.h"
 #include "support/scratch_dir.h"
 
@@ -27,16 +28,13 @@ Scene test_scene(const std::string& integrator) {
                                R"(, "spp": 8, "seed": 5}})");
 }
 
-bool same_floats(const std::vector<float>& a, const std::vector<float>& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0;
-}
-
 void expect_same_image(const RenderResult& a, const RenderResult& b) {
-  EXPECT_TRUE(same_floats(a.image.rgb, b.image.rgb));
-  EXPECT_TRUE(same_floats(a.image.alpha, b.image.alpha));
+  EXPECT_TRUE(test::same_floats(a.image.rgb, b.image.rgb));
+  EXPECT_TRUE(test::same_floats(a.image.alpha, b.image.alpha));
   ASSERT_EQ(a.image.channels.size(), b.image.channels.size());
   for (size_t c = 0; c < a.image.channels.size(); ++c)
-    EXPECT_TRUE(same_floats(a.image.channels[c].data, b.image.channels[c].data)) << a.image.channels[c].name;
+    EXPECT_TRUE(test::same_floats(a.image.channels[c].data, b.image.channels[c].data))
+        << a.image.channels[c].name;
 }
 
 TEST(Progressive, PassesDoubleTheSamples) {
@@ -72,7 +70,7 @@ TEST(Progressive, ResumedRenderEqualsOneRenderBitForBit) {
     EXPECT_EQ(resumed.spp, 8);
     expect_same_image(whole, resumed);
     // And the resumed image differs from a render of fewer samples (the test can fail).
-    EXPECT_FALSE(same_floats(part.image.rgb, resumed.image.rgb));
+    EXPECT_FALSE(test::same_floats(part.image.rgb, resumed.image.rgb));
   }
 }
 
@@ -162,7 +160,7 @@ TEST(Progressive, FilmStateSurvivesTheExr) {
   }
   // The image part reads as a one-part file does.
   const Image back = read_exr(file);
-  EXPECT_TRUE(same_floats(back.rgb, r.image.rgb));
+  EXPECT_TRUE(test::same_floats(back.rgb, r.image.rgb));
   // A file without a state names itself.
   write_exr(scratch.path / "b.exr", r.image);
   try {

@@ -17,7 +17,7 @@ std::string meta(const RenderResult& r, const std::string& key) {
   return "";
 }
 
-Scene sphere_scene(const std::string& integrator) {
+Scene settings_sphere_scene(const std::string& integrator) {
   return test::scene_from_json("{" + test::camera_json(8, 6) + R"(,
     "media": [{"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1}, "sigma_s": 3.0, "sigma_a": 0.1,
                "phase": {"type": "hg", "g": 0.8}}],
@@ -28,7 +28,8 @@ Scene sphere_scene(const std::string& integrator) {
 }
 
 TEST(RenderSettings, AutoChoicesAreResolvedInTheHeader) {
-  const Scene scene = sphere_scene(R"({"type": "mfs", "spp": 1, "photons": 4096, "beam_photons": 1024})");
+  const Scene scene =
+      settings_sphere_scene(R"({"type": "mfs", "spp": 1, "photons": 4096, "beam_photons": 1024})");
   const RenderResult r = render(scene);
   ASSERT_TRUE(r.settings["scatter_grid_resolution"].is_number_integer());
   EXPECT_GE(r.settings["scatter_grid_resolution"].get<int>(), 32);
@@ -48,7 +49,8 @@ TEST(RenderSettings, AutoChoicesAreResolvedInTheHeader) {
 }
 
 TEST(RenderSettings, OverridesAreWhatTheHeaderSays) {
-  const Scene scene = sphere_scene(R"({"type": "pathtrace", "spp": 2, "seed": 5, "max_wide_scatters": 1})");
+  const Scene scene =
+      settings_sphere_scene(R"({"type": "pathtrace", "spp": 2, "seed": 5, "max_wide_scatters": 1})");
   RenderOptions o;
   o.integrator = "single";
   o.spp = 1;

@@ -96,8 +96,9 @@ TEST(Surfaces, ACubeMeshEqualsTheAnalyticBox) {
 }
 
 // The mean of Li along one ray over n samples, per channel.
-std::array<MeanAccumulator, 3> mean_radiance(const Scene& scene, const std::string& type, const Ray& ray,
-                                             int n, std::vector<CameraSample>* samples = nullptr) {
+std::array<MeanAccumulator, 3> surface_mean_radiance(const Scene& scene, const std::string& type,
+                                                     const Ray& ray, int n,
+                                                     std::vector<CameraSample>* samples = nullptr) {
   IntegratorSettings settings = scene.integrator;
   settings.type = type;
   settings.options = nlohmann::json::object();
@@ -144,7 +145,7 @@ TEST(SurfaceLight, DiffuseGroundUnderAnAbsorbingSlabIsExact) {
     exact[c] = albedo[c] / kPi * 2.0 * cos_sun * std::exp(-sigma_a[c] * (1.0 / cos_sun + 1.0 / cos_view));
   for (const std::string type : kIntegrators) {
     std::vector<CameraSample> cs;
-    expect_radiance(mean_radiance(scene, type, {o, d}, samples_for(type), &cs), exact, type);
+    expect_radiance(surface_mean_radiance(scene, type, {o, d}, samples_for(type), &cs), exact, type);
     EXPECT_NEAR(cs[0].depth, length(target - o), 1e-5) << type;
     EXPECT_EQ(cs[0].escape_transmittance, Rgb(0.0)) << type;
     EXPECT_EQ(cs[0].albedo, albedo) << type;
@@ -171,7 +172,7 @@ TEST(SurfaceLight, DiffuseSphereInsideAnAbsorbingMediumIsExact) {
   ASSERT_GT(dot(n, l), 0.1);
   const double exact = 0.6 / kPi * 3.0 * dot(n, l) * std::exp(-0.4 * (to_box + camera_leg));
   for (const std::string type : kIntegrators)
-    expect_radiance(mean_radiance(scene, type, {o, d}, samples_for(type)), Rgb(exact), type);
+    expect_radiance(surface_mean_radiance(scene, type, {o, d}, samples_for(type)), Rgb(exact), type);
 }
 
 // A holdout is black with zero alpha behind what lies in front of it: the camera ray's transmittance to it.
@@ -184,7 +185,7 @@ TEST(SurfaceLight, AHoldoutIsBlackAndRecordsTheTransmittanceToIt) {
   const Ray ray{Vec3(0, -5, 0), Vec3(0, 1, 0)};
   for (const std::string type : kIntegrators) {
     std::vector<CameraSample> cs;
-    const auto m = mean_radiance(scene, type, ray, samples_for(type) / 10, &cs);
+    const auto m = surface_mean_radiance(scene, type, ray, samples_for(type) / 10, &cs);
     MeanAccumulator holdout;
     for (const CameraSample& s : cs) {
       holdout.add(s.holdout_transmittance[0]);
@@ -210,7 +211,7 @@ TEST(SurfaceLight, ARoofShadowsTheMediumCompletely) {
   for (const std::string type : kIntegrators) {
     for (int k = 0; k < 4; ++k) {
       const Vec3 d = normalize(Vec3(dirs.uniform() - 0.5, 4.0, dirs.uniform() - 0.7));
-      const auto m = mean_radiance(scene, type, {Vec3(0, -5, 0), d}, 200);
+      const auto m = surface_mean_radiance(scene, type, {Vec3(0, -5, 0), d}, 200);
       for (int c = 0; c < 3; ++c) EXPECT_EQ(m[c].mean, 0.0) << type << " ray " << k;
     }
   }

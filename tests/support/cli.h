@@ -2,6 +2,7 @@
 #pragma once
 
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <cstdio>
 #include <cstdlib>
@@ -9,6 +10,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "nimbus/image.h"
 
@@ -51,6 +53,22 @@ inline std::string meta_value(const ImageMetadata& meta, const std::string& key)
   for (const auto& [k, v] : meta)
     if (k == key) return v;
   return "(missing)";
+}
+
+// A directory for a test file's outputs, one per process (kept: the CLI tests look at it after a failure).
+inline std::filesystem::path cli_temp_dir(const std::string& tag) {
+  auto d = std::filesystem::temp_directory_path() / ("nimbus_" + tag + "_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(d);
+  return d;
+}
+
+// The comma-separated fields of a CSV line (no quoting: the transport commands write none).
+inline std::vector<std::string> split_csv(const std::string& line) {
+  std::vector<std::string> v;
+  std::stringstream ss(line);
+  std::string item;
+  while (std::getline(ss, item, ',')) v.push_back(item);
+  return v;
 }
 
 }  // namespace nimbus::test

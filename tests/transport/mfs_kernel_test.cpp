@@ -17,7 +17,7 @@ namespace {
 struct Case {
   double z, b, a, theta2;
 };
-const Case kCases[] = {
+const Case kKernelCases[] = {
     {1.0, 1.0, 0.0, 0.01}, {10.0, 1.0, 0.01, 0.01}, {30.0, 1.0, 0.1, 0.02}, {3.0, 2.0, 0.5, 0.005}};
 
 // 4-D trapezoid over (r, v) of the fixed-axis kernel for a source along the axis.
@@ -37,7 +37,7 @@ double integrate_fixed_axis(const MfsScales& s, const GaussianBeam& g) {
 }
 
 TEST(MfsKernel, IntegralOverPlaneAndAngleIsWOverCosh) {
-  for (const Case& c : kCases) {
+  for (const Case& c : kKernelCases) {
     const MfsScales s = mfs_scales(GaussianModel::Mfs, c.z, c.b * c.z, c.a * c.z, c.theta2);
     const GaussianBeam g = gaussian_beam(GaussianModel::Mfs, c.z, c.b * c.z, c.a * c.z, c.theta2);
     const double L = 1.0 / std::sqrt(c.a * s.T);
