@@ -413,34 +413,36 @@ def size_text(cloud128):
     noise = cloud128["reference_noise_rel_rmse"]
     m = min(cloud128["mfs"], key=lambda q: q["rel_rmse"])
     e = math.sqrt(max(m["rel_rmse"] ** 2 - noise ** 2, 1e-12))
-    c2 = cloud128["fit"]["c2"]
-    spp4, spp16 = ratio * c2 / e ** 2, c2 / e ** 2
+    c2, k128 = cloud128["fit"]["c2"], cloud128["fit"]["k_cpu_s"]
+    spp4, spp16 = ratio * c2 / e ** 2, c2 / 16 / e ** 2
     t4, t16 = t0 + k * spp4, t0 + k * spp16
+    ref_cost = 16 * k128 * cloud128["reference_spp"]
     lines = [
         f"Measured (commit {z['commit']}, load average {z['machine']['load_average'][0]:.0f} on 2 cores): path "
         f"tracing's per-sample variance at the binned metric, c = rel RMSE^2 x spp, from two independent 4-spp "
         f"renders of the middle of the frame (no reference needed: var(a - b) = 2 var), is {z['pathtrace_c2_512']:.2f} "
         f"in the 512 x 512 frame's middle (pixels {z['crop_512']}) against {z['pathtrace_c2_128']:.2f} in the same "
-        f"middle of the 128 x 128 frame (pixels {z['crop_128']}): {ratio:.1f}x (a 4 x 4 bin holds 16 times fewer "
-        f"samples at the same spp: 16x expected). The whole 512 x 512 frame costs `pathtrace` {k:.2f} CPU s per spp "
-        f"(1 spp: {p1['cpu_s']:.1f} s, 4 spp: {p4['cpu_s']:.1f} s) and `mfs` at 1 spp {m1['cpu_s']:.1f} CPU s "
-        f"({m1['time_s']:.0f} s wall).", "",
-        f"Not measured: `mfs`'s error at 512 x 512. A reference good to a few per cent at 4 x 4 bins of 512 x 512 "
-        f"needs about 16 times the samples per pixel of the 128 x 128 one, in 16 times the pixels: the middle "
-        f"128 x 128 pixels alone cost 1.1 CPU s per spp, so a 1024-spp reference of them alone is about 20 CPU "
-        f"minutes, more than this loaded machine gave us in the time. What the measured parts bound: `mfs`'s "
-        f"binned error at 512 x 512 is at least its error at 128 x 128 ({e:.1%} with the reference noise removed, "
-        f"at {m['spp']} spp; a 4 x 4 bin of 512 x 512 is a quarter of a 128 x 128 pixel, and a mean of squares "
-        f"over finer bins is never smaller than over their unions, for the bias and for the noise of the same "
-        f"samples per area), so path tracing needs at most {ratio:.1f} x {c2:.2f} / {e:.3f}^2 = {spp4:.0f} spp there, "
-        f"{t4:.0f} CPU s for the frame: the equal-error speed-up of `mfs` (1 spp, {m1['cpu_s']:.1f} s) at "
-        f"512 x 512 is **at most {t4 / m1['cpu_s']:.0f}x** (uniform path tracing; adaptive sampling was not run at this "
-        f"size). If its error at 512 x 512 equals that bound it is about that; each doubling of its error there "
-        f"divides the speed-up by 4.", "",
-        f"Measured at the same scene area instead (bins of 16 x 16 pixels at 512 x 512, the area of a 4 x 4 bin at "
-        f"128 x 128), path tracing needs the 128 x 128 frame's {spp16:.0f} spp, {t16:.0f} CPU s at 512 x 512: "
-        f"{t16 / m1['cpu_s']:.1f}x. The pixel-bin metric rewards `mfs` at larger images because path tracing's noise per "
-        f"bin grows with the pixel count at a fixed spp while `mfs`'s error is mostly bias."]
+        f"middle of the 128 x 128 frame (pixels {z['crop_128']}): {ratio:.2f}x. A 4 x 4 bin holds 16 spp samples at "
+        f"either size, so path tracing needs about the same spp at 512 x 512 as at 128 x 128 for the same binned "
+        f"error, over 16 times the pixels. The whole 512 x 512 frame costs `pathtrace` {k:.2f} CPU s per spp "
+        f"(1 spp: {p1['cpu_s']:.1f} s, 4 spp: {p4['cpu_s']:.1f} s; 128 x 128: {k128:.3f}) and `mfs` at 1 spp "
+        f"{m1['cpu_s']:.1f} CPU s ({m1['time_s']:.0f} s wall; at 128 x 128 {cloud128['mfs'][0]['cpu_s']:.1f} s, "
+        f"{cloud128['mfs_setup_cpu_s']:.1f} s of it set-up).", "",
+        f"Not measured: `mfs`'s error at 512 x 512. Its reference needs the 128 x 128 reference's spp "
+        f"({cloud128['reference_spp']}) over 16 times the pixels, about {ref_cost:.0f} CPU s, more than this "
+        f"loaded machine gave us in the time. What the measured parts bound: `mfs`'s binned error at 512 x 512 is "
+        f"at least about its error at 128 x 128 ({e:.1%} with the reference noise removed, at {m['spp']} spp: a "
+        f"4 x 4 bin of 512 x 512 is a quarter of a 128 x 128 pixel, and a mean of squared errors over finer bins is "
+        f"not smaller than over their unions, up to the bins' selection), so path tracing needs at most "
+        f"{ratio:.2f} x {c2:.2f} / {e:.3f}^2 = {spp4:.0f} spp there, {t4:.0f} CPU s for the frame: the equal-error "
+        f"speed-up of `mfs` (1 spp, {m1['cpu_s']:.1f} s) at 512 x 512 is **at most {t4 / m1['cpu_s']:.0f}x** "
+        f"(uniform path tracing; adaptive sampling was not run at this size). If its error there equals its "
+        f"128 x 128 error it is about that; each doubling of its error divides the speed-up by 4. It is larger "
+        f"than at 128 x 128 because `mfs`'s set-up does not grow with the image while path tracing's cost does.",
+        "",
+        f"At the same scene area instead (16 x 16-pixel bins at 512 x 512, the area of a 4 x 4 bin at 128 x 128, "
+        f"16 times the samples) path tracing would need 1/16 of the spp, {spp16:.0f}, {t16:.0f} CPU s: "
+        f"{t16 / m1['cpu_s']:.1f}x, no better than at 128 x 128 (`mfs` pays for the pixels, path tracing does not)."]
     write_between_markers("size512", "\n".join(lines))
     return {"c2_ratio": ratio, "k_512": k, "t0_512": t0, "mfs_error_128": e, "pathtrace_spp_512": spp4,
             "pathtrace_cpu_s_512": t4, "speedup_bound_512": t4 / m1["cpu_s"], "speedup_same_area": t16 / m1["cpu_s"]}
@@ -504,8 +506,11 @@ def write_table(results):
         return
     r0 = res[names[0]]
     loads = [r["machine"]["load_average"][0] for r in res.values()]
-    head = [f"{r0['width']} x {r0['height']}, commit {r0['commit']}, {r0['machine']['date']}; load average "
-            f"{min(loads):.1f} to {max(loads):.1f} on {r0['machine']['cpus']} cores while measured.", ""]
+    commits = sorted({r["commit"] for r in res.values()})
+    dates = sorted(r["machine"]["date"] for r in res.values())
+    head = [f"{r0['width']} x {r0['height']}, commits {', '.join(commits)} (these differ in validation/ only: the "
+            f"renderer is main's 220836a), {dates[0]} to {dates[-1][11:]}; load average {min(loads):.1f} to "
+            f"{max(loads):.1f} on {r0['machine']['cpus']} cores while measured.", ""]
     text = "\n".join(head + speed_rows(res) + ["", "The frontiers (rel RMSE @ CPU seconds):", ""] +
                      frontier_rows(res))
     print(text)
