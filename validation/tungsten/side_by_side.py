@@ -12,9 +12,11 @@ with independent seeds on one thread, alternating the two renderers, and prints 
                   over its samples: the median over the K runs, and the same with the start-up (the median
                   CPU time of 1-spp renders) taken off
   efficiency      1 / (var/sample x ns/sample), and the ratio nimbus / Tungsten
+and how well the two images agree in 8 x 8 pixel bins (z: differences in standard errors).
 
 Usage:  /usr/bin/python3 validation/tungsten/side_by_side.py --tungsten /work/tungsten-src/build/tungsten
             [--nimbus build/bin/nimbus] [--spp 256] [-K 12] [--scenes front,side,back] [--keep DIR]
+            [--tungsten-sobol] [--json FILE]
 """
 import argparse
 import json
@@ -23,7 +25,6 @@ import os
 import resource
 import statistics
 import subprocess
-import sys
 import struct
 import tempfile
 import zlib
@@ -62,12 +63,13 @@ def cap_radiance(irradiance, cap_deg):
     return irradiance / (math.pi * (1 - c * c))
 
 
-def tungsten_scene(tau, albedo, g, light):
+def tungsten_scene(tau, albedo, g, light, sobol=False):
     """The same scene in Tungsten's format: the medium fills a unit sphere with an index-matched
     ("forward") boundary; the light is an infinite_sphere_cap of CAP_DEG around the direction it comes
     from (its +y axis, set by the transform's `up`). min_bounces 1 hides the cap from camera rays that
     miss the sphere (nimbus's directional light is not seen by the camera); no camera ray through the
-    sphere points into the cap in these three scenes."""
+    sphere points into the cap in these three scenes. sobol: Tungsten's default sampler (a Sobol sequence
+    per pixel) instead of independent random numbers."""
     n = math.sqrt(sum(c * c for c in light))
     towards = [-c / n for c in light]
     return {
@@ -87,7 +89,7 @@ def tungsten_scene(tau, albedo, g, light):
                        "enable_consistency_checks": False, "enable_two_sided_shading": True},
         "renderer": {"output_file": "tungsten.png", "overwrite_output_files": True,
                      "adaptive_sampling": False, "enable_resume_render": False,
-                     "stratified_sampler": False, "scene_bvh": True, "spp": 16, "spp_step": 16,
+                     "stratified_sampler": sobol, "scene_bvh": True, "spp": 16, "spp_step": 16,
                      "checkpoint_interval": "0", "timeout": "0"},
     }
 
@@ -199,6 +201,20 @@ def stats(images, cpus, startup, spp):
             "startup_s": startup}
 
 
+def binned_agreement(a, b, k=8):
+    """The two renderers' K images averaged over k x k pixel bins: the rms and the largest |z| of their
+    difference over the lit bins (mean above 5 % of the brightest), z in standard errors of the
+    difference from the spread of the K images."""
+    def bins(images):
+        x = np.stack(images).mean(-1)
+        return x.reshape(len(images), x.shape[1] // k, k, x.shape[2] // k, k).mean((2, 4))
+    ba, bb = bins(a), bins(b)
+    lit = ba.mean(0) > 0.05 * ba.mean(0).max()
+    se = np.sqrt(ba.var(0, ddof=1) / len(ba) + bb.var(0, ddof=1) / len(bb))
+    z = (ba.mean(0) - bb.mean(0))[lit] / se[lit]
+    return float(np.sqrt(np.mean(z * z))), float(np.abs(z).max()), int(lit.sum())
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--tungsten", required=True, help="the built tungsten binary")
@@ -207,6 +223,8 @@ def main():
     ap.add_argument("-K", type=int, default=12, help="independent seeds per renderer and scene")
     ap.add_argument("--startup-runs", type=int, default=3, help="1-spp renders to time the start-up")
     ap.add_argument("--scenes", default="front,side,back")
+    ap.add_argument("--tungsten-sobol", action="store_true",
+                    help="Tungsten with its default Sobol sampler (else independent random numbers, as nimbus)")
     ap.add_argument("--keep", help="write scenes and images here instead of a temporary folder")
     ap.add_argument("--json", help="also write the results here")
     args = ap.parse_args()
@@ -220,7 +238,7 @@ def main():
         os.makedirs(d, exist_ok=True)
         nscene, tscene = os.path.join(d, "nimbus.json"), os.path.join(d, "tungsten.json")
         json.dump(nimbus_scene(tau, albedo, g, light), open(nscene, "w"), indent=1)
-        json.dump(tungsten_scene(tau, albedo, g, light), open(tscene, "w"), indent=1)
+        json.dump(tungsten_scene(tau, albedo, g, light, args.tungsten_sobol), open(tscene, "w"), indent=1)
         runners = {"nimbus": lambda spp, seed: render_nimbus(args.nimbus, nscene, d, spp, seed),
                    "tungsten": lambda spp, seed: render_tungsten(args.tungsten, tscene, d, spp, seed)}
         startup = {r: [] for r in runners}
@@ -237,6 +255,8 @@ def main():
         for r in runners:
             res[r]["eff"] = 1e9 / (res[r]["var"] * res[r]["ns"])
             res[r]["eff_net"] = 1e9 / (res[r]["var"] * res[r]["ns_net"])
+        res["bins_rms_z"], res["bins_max_z"], res["bins_lit"] = binned_agreement(images["nimbus"],
+                                                                                  images["tungsten"])
         results[name] = res
         n, t = res["nimbus"], res["tungsten"]
         diff = (n["mean"] - t["mean"]) / math.hypot(n["mean_se"], t["mean_se"])
@@ -246,7 +266,9 @@ def main():
             print(f"  {r:9s} mean {x['mean']:.5f} +- {x['mean_se']:.5f}  var/sample {x['var']:.4e} +- "
                   f"{x['var_se']:.1e}  ns/sample {x['ns']:.0f} [{x['ns_min']:.0f}, {x['ns_max']:.0f}] "
                   f"(start-up {x['startup_s']:.3f} s, net {x['ns_net']:.0f})  efficiency {x['eff']:.4e}")
-        print(f"  means differ by {diff:+.2f} standard errors; nimbus / Tungsten: variance "
+        print(f"  means differ by {diff:+.2f} standard errors; 8 x 8 bins: rms z {res['bins_rms_z']:.2f}, max |z| "
+              f"{res['bins_max_z']:.2f} over {res['bins_lit']} lit bins")
+        print(f"  nimbus / Tungsten: variance "
               f"{n['var'] / t['var']:.3f}, time {n['ns'] / t['ns']:.3f} (net {n['ns_net'] / t['ns_net']:.3f}), "
               f"efficiency {n['eff'] / t['eff']:.2f} (net {n['eff_net'] / t['eff_net']:.2f})", flush=True)
     if args.json:
