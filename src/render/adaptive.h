@@ -39,8 +39,8 @@ inline constexpr double kSampleOverheadDraws = 8.0;
 
 // The next pass: pixels move towards the allocation that minimises the binned error for the cost spent
 // (samples in proportion to the pixel's standard deviation over the square root of its cost per sample,
-// both pooled over its 3 x 3 neighbours so that a pixel whose few samples happened to agree is not
-// starved), each at most doubling its count.
+// both taken from its 3 x 3 neighbours, not from its own samples: a count that its own samples decide
+// biases its mean, dark where rare bright paths make the light), each at most doubling its count.
 // Nothing more is planned once the estimated error is at or below the target.
 AdaptivePlan plan_adaptive_pass(const Film& film, int layer, const AdaptiveSettings& settings);
 

@@ -71,7 +71,9 @@ TEST(Adaptive, EstimateIsTheBinnedRelativeErrorOfTheVariances) {
 TEST(Adaptive, TargetsFollowTheStandardDeviation) {
   // With the doubling bound out of the way (n = 64, the goal close to the estimate), the planned
   // counts of the noisiest pixels equal lambda sqrt(v) / m: checked through their ratio, which is the
-  // ratio of the pooled standard deviations (v : 2v/3 in columns 5 and 4).
+  // ratio of the standard deviations pooled over their neighbours (not themselves). In the top row:
+  // column 5's five neighbours all have v; column 4's are columns 3 (0) and 5 (v) beside it and 3, 4,
+  // 5 below it: 3v/5.
   int y2 = 0;
   const Film film = two_halves(64, &y2);
   AdaptiveSettings s;
@@ -80,7 +82,42 @@ TEST(Adaptive, TargetsFollowTheStandardDeviation) {
   s.noise = plan_adaptive_pass(film, y2, s).estimated_error / 1.2;
   const AdaptivePlan plan = plan_adaptive_pass(film, y2, s);
   const double r = double(plan.target[5]) / double(plan.target[4]);
-  EXPECT_NEAR(r, std::sqrt(1.5), 0.05);
+  EXPECT_NEAR(r, std::sqrt(5.0 / 3.0), 0.05);
+}
+
+TEST(Adaptive, APixelsOwnSamplesDoNotDecideItsCount) {
+  // Every pixel alike (samples 0.5 and 1.5), but pixel (3, 3)'s samples all 1 (no variance: "converged")
+  // or one of them 40 (a rare bright path). Its planned count is the one of pixel (5, 5), whose
+  // neighbours are as noisy as its own: had its own samples decided, the quiet pixel would stop (and its
+  // pixels' mean would be biased dark over many renders) and the bright one would take the most.
+  for (const double odd : {1.0, 40.0}) {
+    Film film(8, 8);
+    const int layer = film.add_layer(kAdaptiveLayer, kAdaptiveChannels);
+    for (int y = 0; y < 8; ++y)
+      for (int x = 0; x < 8; ++x)
+        for (int s = 0; s < 32; ++s) {
+          double value = s % 2 ? 1.5 : 0.5;
+          if (x == 3 && y == 3) value = odd == 1.0 ? 1.0 : (s == 0 ? odd : value);
+          add_grey(film, layer, x, y, value);
+        }
+    AdaptiveSettings st;
+    st.bin = 1;
+    st.max_spp = 1 << 20;
+    st.noise = plan_adaptive_pass(film, layer, st).estimated_error / 1.2;
+    const AdaptivePlan plan = plan_adaptive_pass(film, layer, st);
+    const uint32_t odd_pixel = plan.target[3 * 8 + 3], far = plan.target[5 * 8 + 5],
+                   beside = plan.target[4 * 8 + 4];
+    EXPECT_EQ(odd_pixel, far) << odd;
+    // The power of the check: the counts follow the variance around them. Pixel (4, 4) has the odd one
+    // among its neighbours: fewer samples beside the quiet pixel, more beside the bright one.
+    if (odd == 1.0) {
+      EXPECT_GT(far, 32u);
+      EXPECT_LT(far, 64u);  // inside the doubling bound
+      EXPECT_LT(beside, far);
+    } else {
+      EXPECT_GT(beside, far);
+    }
+  }
 }
 
 TEST(Adaptive, CostlierPixelsTakeFewerSamples) {
