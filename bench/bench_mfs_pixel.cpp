@@ -9,7 +9,7 @@
 //  - BM_MfsPixelSkeleton: the same rays through the bare march (march_growing with the media's
 //    extinction and the camera-side state, no lights, no grids): the floor that the light estimators sit on.
 // range(0) picks the scene (kScenes), range(1) the image width (height from the scene's aspect), range(2)
-// the threads. Results: docs/benchmarks.md, "Per-pixel cost of mfs and the 1080p cloud".
+// the threads. The integrator's options: the defaults, or those in $NIMBUS_BENCH_MFS (a JSON object). Results: docs/benchmarks.md, "Per-pixel cost of mfs and the 1080p cloud".
 #include <benchmark/benchmark.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -18,6 +18,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <ctime>
 #include <filesystem>
 #include <map>
@@ -45,7 +46,10 @@ Scene load(int scene, int width) {
   return s;
 }
 
-const nlohmann::json kMfs = nlohmann::json::object();  // the defaults
+// The integrator's options: the defaults, or the JSON object in $NIMBUS_BENCH_MFS (e.g. '{"tau_step": 0.1}').
+const nlohmann::json kMfs = std::getenv("NIMBUS_BENCH_MFS")
+                                ? nlohmann::json::parse(std::getenv("NIMBUS_BENCH_MFS"))
+                                : nlohmann::json::object();
 
 // A scene with its context and integrator, built once per (scene, width) and kept for the process.
 struct Prepared {
