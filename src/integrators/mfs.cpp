@@ -167,6 +167,7 @@ Rgb MfsIntegrator::trace(const Ray& ray, Rng& rng, CameraSample* sample, int bou
       // Steps grow with the camera-side reduced depth: tau_step (1 + step_growth tau_red) (eq. D13).
       [&] { return 1.0 + s_.step_growth * max_component(cam.tau_red); },
       [&](const Vec3& p, double t, double dt) {
+        ++mfs_march_steps;
         // Split the extinction at p into peak and reduced parts (eq. D2).
         ctx_.media.eval(p, &mp);
         const MfsExtinction k = mfs_extinction(mp, f_, theta2_);

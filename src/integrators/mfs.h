@@ -96,6 +96,10 @@ struct MfsSettings {
 MfsSettings mfs_settings_from_json(const nlohmann::json& options, const std::string& where);
 nlohmann::json to_json(const MfsSettings& s);
 
+// March steps taken by this thread's `mfs` camera rays (all of them, gathered rays included): one
+// increment per step, read by bench/bench_mfs_pixel.cpp for steps per ray; no effect on any image.
+inline thread_local uint64_t mfs_march_steps = 0;
+
 class MfsIntegrator final : public Integrator {
  public:
   // seed: the scene's, for the photon grids.

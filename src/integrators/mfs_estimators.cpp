@@ -6,6 +6,18 @@
 
 namespace nimbus {
 
+namespace {
+// exp of each channel, taken once where neighbouring channels are equal (grey media, the common case): the
+// same values bit for bit as exp(x), a third of the exps.
+Rgb exp_channels(const Rgb& x) {
+  Rgb r;
+  r[0] = std::exp(x[0]);
+  r[1] = x[1] == x[0] ? r[0] : std::exp(x[1]);
+  r[2] = x[2] == x[1] ? r[1] : std::exp(x[2]);
+  return r;
+}
+}  // namespace
+
 double path_lengthening(double theta, double tau) {
   // docs/derivations.md eq. D5: 1 / cosh(x) = 2 e^-x / (1 + e^-2x), x = sqrt(theta tau).
   const double x = std::sqrt(std::max(0.0, theta * tau));
@@ -31,13 +43,13 @@ MfsExtinction mfs_extinction(const MediumPoint& mp, const std::vector<double>& f
 CameraPoint CameraPath::at(const MfsExtinction& k, double jitter, double dt, bool light_side,
                            bool lengthening) const {
   CameraPoint y;
-  y.T_full = T_full * exp(-k.sigma_t * (jitter * dt));
+  y.T_full = T_full * exp_channels(-k.sigma_t * (jitter * dt));
   if (light_side) {
     y.T_cam = y.T_full;
   } else {
     // Light scattered at y is carried to the camera by the propagator: only absorption and wide
     // scatters remove it (eq. D2), and its lengthened paths lose eq. D5.
-    y.T_cam = T_red * exp(-k.sigma_red * (jitter * dt));
+    y.T_cam = T_red * exp_channels(-k.sigma_red * (jitter * dt));
     if (lengthening)
       for (int c = 0; c < 3; ++c)
         y.T_cam[c] *= path_lengthening(theta_p[c] + k.sigma_theta[c] * jitter * dt,
@@ -48,8 +60,8 @@ CameraPoint CameraPath::at(const MfsExtinction& k, double jitter, double dt, boo
 }
 
 void CameraPath::advance(const MfsExtinction& k, double t, double dt, double jitter) {
-  T_full *= exp(-k.sigma_t * dt);
-  T_red *= exp(-k.sigma_red * dt);
+  T_full *= exp_channels(-k.sigma_t * dt);
+  T_red *= exp_channels(-k.sigma_red * dt);
   tau_p += k.sigma_peak * dt;
   theta_p += k.sigma_theta * dt;
   tau_red += k.sigma_red * dt;
@@ -93,14 +105,16 @@ Rgb first_wide_scatter(const Rgb& E, double f, const PhaseSplit& split, double m
                        const Rgb& tau_ps, const Rgb& T_wide) {
   // eq. D7, first term: light- and camera-side peak depths add (eq. D4).
   Rgb L;
-  for (int c = 0; c < 3; ++c) L[c] = E[c] * (1.0 - f) * split.wide_eff(tau_p[c] + tau_ps[c], mu) * T_wide[c];
+  const PhaseSplit::Angle a = PhaseSplit::angle(mu);
+  for (int c = 0; c < 3; ++c) L[c] = E[c] * (1.0 - f) * split.wide_eff(tau_p[c] + tau_ps[c], a) * T_wide[c];
   return L;
 }
 
 Rgb forward_peak(const Rgb& E, double f, const PhaseSplit& split, double mu, const Rgb& tau, const Rgb& T) {
   // eq. D7, second term (or D7b for beer_lambert).
   Rgb L;
-  for (int c = 0; c < 3; ++c) L[c] = E[c] * f * split.peak_eff(tau[c], mu) * T[c];
+  const PhaseSplit::Angle a = PhaseSplit::angle(mu);
+  for (int c = 0; c < 3; ++c) L[c] = E[c] * f * split.peak_eff(tau[c], a) * T[c];
   return L;
 }
 
@@ -108,8 +122,9 @@ Rgb light_side_scatter(const Rgb& E, double f, const PhaseSplit& split, double m
                        const Rgb& T_wide) {
   // eq. D11.
   Rgb L;
+  const PhaseSplit::Angle a = PhaseSplit::angle(mu);
   for (int c = 0; c < 3; ++c)
-    L[c] = E[c] * T_wide[c] * ((1.0 - f) * split.wide_eff(tau_ps[c], mu) + f * split.peak_eff(tau_ps[c], mu));
+    L[c] = E[c] * T_wide[c] * ((1.0 - f) * split.wide_eff(tau_ps[c], a) + f * split.peak_eff(tau_ps[c], a));
   return L;
 }
 
@@ -124,9 +139,12 @@ std::array<Rgb, kShMaxBands> blurred_wide_moments(const PhaseSplit& split, const
   const std::vector<double>& chi_w = split.wide_moments();
   const std::vector<double>& chi_p = split.peak_moments();
   std::array<Rgb, kShMaxBands> chi{};
-  for (int l = 0; l < bands; ++l)
-    for (int c = 0; c < 3; ++c)
-      chi[l][c] = moment(chi_w, l, 0.0) * std::exp(-tau_p[c] * (1.0 - moment(chi_p, l, 1.0)));
+  for (int l = 0; l < bands; ++l) {
+    const double one_minus_chi = 1.0 - moment(chi_p, l, 1.0);
+    const Rgb e =
+        exp_channels(Rgb(-tau_p[0] * one_minus_chi, -tau_p[1] * one_minus_chi, -tau_p[2] * one_minus_chi));
+    for (int c = 0; c < 3; ++c) chi[l][c] = moment(chi_w, l, 0.0) * e[c];
+  }
   return chi;
 }
 

@@ -177,12 +177,17 @@ double PhaseSplit::peak(double cos_theta) const {
   return std::max(0.0, phase_eval(phase_, cos_theta) - level_) / f_;
 }
 
-double PhaseSplit::lookup(const std::vector<float>& table, double tau_p, double cos_theta) const {
+PhaseSplit::Angle PhaseSplit::angle(double cos_theta) {
   const double th = std::acos(std::clamp(cos_theta, -1.0, 1.0));
   const double a = std::sqrt(th / kPi) * (kAngleNodes - 1);
+  const int j = std::min(int(a), kAngleNodes - 2);
+  return {j, a - j};
+}
+
+double PhaseSplit::lookup(const std::vector<float>& table, double tau_p, const Angle& an) const {
   const double t = std::sqrt(std::clamp(tau_p, 0.0, kTauMax) / kTauMax) * (kTauNodes - 1);
-  const int j = std::min(int(a), kAngleNodes - 2), k = std::min(int(t), kTauNodes - 2);
-  const double fa = a - j, ft = t - k;
+  const int j = an.j, k = std::min(int(t), kTauNodes - 2);
+  const double fa = an.fa, ft = t - k;
   const float* r0 = &table[size_t(k) * kAngleNodes + j];
   const float* r1 = r0 + kAngleNodes;
   return (1 - ft) * ((1 - fa) * r0[0] + fa * r0[1]) + ft * ((1 - fa) * r1[0] + fa * r1[1]);

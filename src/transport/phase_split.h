@@ -39,8 +39,21 @@ class PhaseSplit {
   double wide(double cos_theta) const;
   double peak(double cos_theta) const;
   // Propagated parts (see above), per sr; tau_p >= 0 (clamped to the table's range).
-  double wide_eff(double tau_p, double cos_theta) const { return lookup(wide_table_, tau_p, cos_theta); }
-  double peak_eff(double tau_p, double cos_theta) const { return lookup(peak_table_, tau_p, cos_theta); }
+  double wide_eff(double tau_p, double cos_theta) const {
+    return lookup(wide_table_, tau_p, angle(cos_theta));
+  }
+  double peak_eff(double tau_p, double cos_theta) const {
+    return lookup(peak_table_, tau_p, angle(cos_theta));
+  }
+  // The same with the angle's place in the tables found once (an acos and a sqrt) for several lookups at
+  // one cosine (every channel, both parts): the same values bit for bit.
+  struct Angle {
+    int j;      // the table's angle node below
+    double fa;  // the fraction towards the next
+  };
+  static Angle angle(double cos_theta);
+  double wide_eff(double tau_p, const Angle& a) const { return lookup(wide_table_, tau_p, a); }
+  double peak_eff(double tau_p, const Angle& a) const { return lookup(peak_table_, tau_p, a); }
 
   const std::vector<double>& peak_moments() const { return chi_peak_; }
   // The peak's per-component mean square deflection, (1 - chi_2) / 3 (0 without a peak).
@@ -52,7 +65,7 @@ class PhaseSplit {
   static constexpr double kTauMax = 64.0;
 
  private:
-  double lookup(const std::vector<float>& table, double tau_p, double cos_theta) const;
+  double lookup(const std::vector<float>& table, double tau_p, const Angle& a) const;
 
   Phase phase_;
   double f_ = 0.0, theta_c_ = 0.0, level_ = 0.0;  // level_ = P(theta_c)
