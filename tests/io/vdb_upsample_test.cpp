@@ -52,7 +52,7 @@ TEST(VdbUpsample, TheFineGridIsTheSameField) {
   const DensityGrid coarse = density_grid(*coarse_vdb);
   const Bounds wb = coarse.world_bounds();
   for (const int factor : {2, 3}) {
-    const auto fine_vdb = upsample_float_grid(*coarse_vdb, factor);
+    const auto fine_vdb = detail::upsample_float_grid(*coarse_vdb, factor);
     EXPECT_EQ(fine_vdb->getName(), "density");
     const DensityGrid fine = density_grid(*fine_vdb);
     EXPECT_NEAR(fine.stats().voxel_size.x, 0.5 / factor, 1e-12);
@@ -78,7 +78,7 @@ TEST(VdbUpsample, OneVoxelBecomesItsTent) {
   auto grid = openvdb::FloatGrid::create(0.0f);
   grid->tree().setValueOn(openvdb::Coord(0, 0, 0), 1.0f);
   const int f = 4;
-  const auto fine = upsample_float_grid(*grid, f);
+  const auto fine = detail::upsample_float_grid(*grid, f);
   // The trilinear field of one voxel is prod(1 - |x|) on (-1, 1)^3: non-zero at the (2f - 1)^3 fine
   // voxels with |i| < f per axis.
   EXPECT_EQ(fine->activeVoxelCount(), uint64_t((2 * f - 1) * (2 * f - 1) * (2 * f - 1)));
@@ -91,7 +91,7 @@ TEST(VdbUpsample, OneVoxelBecomesItsTent) {
       EXPECT_NEAR(acc.getValue(openvdb::Coord(i, j, k)), expected, 1e-6) << i << " " << j << " " << k;
     }
   EXPECT_NEAR(fine->voxelSize()[0], 1.0 / f, 1e-12);
-  EXPECT_EQ(upsampled_bbox_voxels(*grid, f), uint64_t((2 * f + 1) * (2 * f + 1) * (2 * f + 1)));
+  EXPECT_EQ(detail::upsampled_bbox_voxels(*grid, f), uint64_t((2 * f + 1) * (2 * f + 1) * (2 * f + 1)));
 }
 
 TEST(VdbUpsample, ConvertWritesTheFineGridAndRefusesBadFactors) {
@@ -103,7 +103,7 @@ TEST(VdbUpsample, ConvertWritesTheFineGridAndRefusesBadFactors) {
   }
   convert_vdb_to_nvdb(dir / "lumpy.vdb", dir / "fine.nvdb", {}, 2);
   EXPECT_NEAR(load_density_grid(dir / "fine.nvdb").stats().voxel_size.x, 0.25, 1e-12);
-  for (const int bad : {0, -1, kMaxUpsample + 1}) {
+  for (const int bad : {0, -1, detail::kMaxUpsample + 1}) {
     try {
       convert_vdb_to_nvdb(dir / "lumpy.vdb", dir / "bad.nvdb", {}, bad);
       ADD_FAILURE() << "factor " << bad << " accepted";
