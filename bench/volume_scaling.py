@@ -14,7 +14,7 @@ render is its CPU time less that of the 4 x 3 render with the same integrator an
 checked: each integrator's render of the upsampled cloud against the same render of the original
 (`nimbus compare --bin 4 --min-ref 0.05`), beside two seeds on the original (the noise floor).
 
-    bench/volume_scaling.py                      # ~20-30 min on 2 loaded cores
+    bench/volume_scaling.py                      # ~40 min on 2 loaded cores (9 min of CPU)
     bench/volume_scaling.py --factors 1,2 --sizes 64x48 --big none --spp-mfs 1 --spp-pt 1   # a smoke run
 
 Writes bench/results/volume_scaling.json and docs/images/volume_scaling.png (paths: --json, --plot).
@@ -203,7 +203,7 @@ def plot(r, path):
                         key=lambda x: x["factor"])
             if not rs:
                 continue
-            label = f"{integrator} {w}x{h}" if w > 4 else f"{integrator} 4x3 (load + set-up)"
+            label = f"{integrator} {w}x{h}" if w > 4 else f"{integrator} 4x3 (fixed cost)"
             xs = [vox[x["factor"]] for x in rs]
             ax[0].plot(xs, [x["cpu_s"] for x in rs], styles[integrator], marker="o", color=colors[i], label=label)
             ax[1].plot(xs, [x["rss_mb"] for x in rs], styles[integrator], marker="o", color=colors[i], label=label)
