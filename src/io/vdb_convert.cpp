@@ -15,7 +15,7 @@ namespace nimbus {
 
 std::vector<std::string> convert_vdb_to_nvdb(const std::filesystem::path& in,
                                              const std::filesystem::path& out,
-                                             const std::vector<std::string>& grids) {
+                                             const std::vector<std::string>& grids, int upsample) {
   if (in.extension() != ".vdb") throw Error(fmt::format("{}: not an OpenVDB (.vdb) file", in.string()));
   std::vector<std::string> names = grids;
   if (names.empty())
@@ -24,7 +24,7 @@ std::vector<std::string> convert_vdb_to_nvdb(const std::filesystem::path& in,
   if (names.empty()) throw Error(fmt::format("{}: no float grid to convert", in.string()));
   std::vector<detail::NanoHandle> handles;
   for (const std::string& name : names) {
-    detail::NanoHandle h = detail::load_openvdb_float_grid(in, name);
+    detail::NanoHandle h = detail::load_openvdb_float_grid(in, name, upsample);
     nanovdb::FloatGrid* grid = h.grid<float>();
     if (!grid)
       throw Error(fmt::format("{}: grid \"{}\" did not convert to a NanoVDB float grid", in.string(), name));

@@ -20,8 +20,10 @@ using NanoHandle = nanovdb::GridHandle<nanovdb::HostBuffer>;
 [[noreturn]] void fail(const std::filesystem::path& file, const std::string& what);
 
 // Reads the float grid `grid_name` ("" = the first float grid) of an OpenVDB file and converts it to
-// NanoVDB. Errors name the file; OpenVDB exceptions are rethrown as nimbus::Error.
-NanoHandle load_openvdb_float_grid(const std::filesystem::path& file, const std::string& grid_name);
+// NanoVDB; `upsample` > 1 first refines it by that factor per axis (io/vdb_upsample.h: the same density
+// field on a finer lattice). Errors name the file; OpenVDB exceptions are rethrown as nimbus::Error.
+NanoHandle load_openvdb_float_grid(const std::filesystem::path& file, const std::string& grid_name,
+                                   int upsample = 1);
 
 // The components of the vec3 grid `grid_name` of an OpenVDB file as three float grids (x, y, z).
 std::array<NanoHandle, 3> load_openvdb_vec3_grid(const std::filesystem::path& file,

@@ -6,6 +6,7 @@
 #include <openvdb/io/Stream.h>
 #include <openvdb/openvdb.h>
 
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <iterator>
@@ -13,6 +14,7 @@
 #include <sstream>
 
 #include "io/vdb_internal.h"
+#include "io/vdb_upsample.h"
 #include "nimbus/error.h"
 
 namespace nimbus::detail {
@@ -161,7 +163,29 @@ void check_index_range(const std::filesystem::path& path, const openvdb::GridBas
   });
 }
 
-NanoHandle load_openvdb_float_grid(const std::filesystem::path& path, const std::string& grid_name) {
+// Before upsampling `grid` by `factor`: a factor in [1, kMaxUpsample], fine index coordinates within
+// +-2^30, and a fine bbox the renderer accepts (at most 2^31 voxels, media/density_grid.cpp), so a
+// too-large request fails at once instead of filling memory.
+static void check_upsample(const std::filesystem::path& path, const openvdb::FloatGrid& grid, int factor) {
+  const std::string name = display_name(grid.getName());
+  if (factor < 1 || factor > kMaxUpsample)
+    fail(path, fmt::format("upsampling grid {} by {}: the factor must be an integer in [1, {}]", name, factor,
+                           kMaxUpsample));
+  const openvdb::CoordBBox bb = grid.evalActiveVoxelBoundingBox();
+  for (int a = 0; a < 3; ++a)
+    if (std::max(std::abs(int64_t(bb.min()[a]) - 1), std::abs(int64_t(bb.max()[a]) + 1)) * factor >=
+        kMaxIndexCoord - 4096)
+      fail(path, fmt::format("upsampling grid {} by {} puts voxels beyond index +-2^30", name, factor));
+  const uint64_t voxels = upsampled_bbox_voxels(grid, factor);
+  if (voxels > (uint64_t(1) << 31))
+    fail(path,
+         fmt::format("upsampling grid {} by {} gives an index bbox of {:.3g} voxels, more than the 2^31 "
+                     "a density grid may hold",
+                     name, factor, double(voxels)));
+}
+
+NanoHandle load_openvdb_float_grid(const std::filesystem::path& path, const std::string& grid_name,
+                                   int upsample) {
   return with_grids(path, [&](const openvdb::GridPtrVec& grids) {
     openvdb::GridBase::ConstPtr chosen;
     for (const auto& g : grids) {
@@ -186,8 +210,12 @@ NanoHandle load_openvdb_float_grid(const std::filesystem::path& path, const std:
       fail(path, fmt::format("grid {} is empty: no active voxels", display_name(grid->getName())));
     check_index_range(path, *grid);
     // No stats or checksum: DensityGrid computes what it needs from the converted tree.
-    return nanovdb::openToNanoVDB<nanovdb::HostBuffer>(*grid, nanovdb::StatsMode::BBox,
-                                                       nanovdb::ChecksumMode::Disable);
+    if (upsample == 1)
+      return nanovdb::openToNanoVDB<nanovdb::HostBuffer>(*grid, nanovdb::StatsMode::BBox,
+                                                         nanovdb::ChecksumMode::Disable);
+    check_upsample(path, *grid, upsample);
+    return nanovdb::openToNanoVDB<nanovdb::HostBuffer>(
+        *upsample_float_grid(*grid, upsample), nanovdb::StatsMode::BBox, nanovdb::ChecksumMode::Disable);
   });
 }
 

@@ -63,5 +63,37 @@ TEST(ConvertCli, VdbBecomesAnEquivalentNvdb) {
   EXPECT_FALSE(fs::exists(dir / "x.png"));
 }
 
+// --upsample N: a grid with voxels N times smaller (the field itself: tests/io/vdb_upsample_test.cpp);
+// a factor outside [1, 16], or with an image, exits 2 with nothing written.
+TEST(ConvertCli, UpsampleRefinesTheGridAndRefusesBadFactors) {
+  const test::ScratchDir dir("convert_upsample");
+  const fs::path vdb = fs::path(NIMBUS_SOURCE_DIR) / "fuzz" / "data" / "tiny.vdb";
+  ASSERT_EQ(run_cli("convert " + vdb.string() + " " + (dir / "t3.nvdb").string() + " --upsample 3").rc, 0);
+  const test::CliRun info = run_cli("info " + (dir / "t3.nvdb").string());
+  EXPECT_NE(info.out.find("voxel size    0.166667 x 0.166667 x 0.166667"), std::string::npos) << info.out;
+  for (const std::string& bad :
+       {"convert " + vdb.string() + " " + (dir / "x.nvdb").string() + " --upsample 0",
+        "convert " + vdb.string() + " " + (dir / "x.nvdb").string() + " --upsample 17",
+        "convert " + vdb.string() + " " + (dir / "x.nvdb").string() + " --upsample two"}) {
+    const test::CliRun r = run_cli(bad);
+    EXPECT_EQ(r.rc, 2) << bad << ": " << r.out;
+    EXPECT_NE(r.out.find("nimbus: error: --upsample"), std::string::npos) << r.out;
+  }
+  EXPECT_FALSE(fs::exists(dir / "x.nvdb"));
+  // An image conversion takes no factor.
+  std::ofstream(dir / "a.json") << R"({"camera": {"position": [0.25, -5, -0.25], "look_at": [0.25, 0, -0.25],
+      "up": [0, 0, 1], "fov_y_deg": 35, "width": 4, "height": 3},
+      "media": [{"shape": {"type": "vdb", "file": ")"
+                                << vdb.string() << R"("}, "sigma_s": 4.0}],
+      "lights": [{"type": "directional", "direction": [1, 1, -1], "irradiance": 2.0}],
+      "integrator": {"type": "pathtrace", "spp": 1}})";
+  ASSERT_EQ(run_cli("render --quiet " + (dir / "a.json").string() + " -o " + (dir / "a.exr").string()).rc, 0);
+  const test::CliRun r =
+      run_cli("convert " + (dir / "a.exr").string() + " " + (dir / "x.png").string() + " --upsample 2");
+  EXPECT_EQ(r.rc, 2) << r.out;
+  EXPECT_NE(r.out.find("--upsample: only for a .vdb -> .nvdb conversion"), std::string::npos) << r.out;
+  EXPECT_FALSE(fs::exists(dir / "x.png"));
+}
+
 }  // namespace
 }  // namespace nimbus
