@@ -11,74 +11,18 @@ Usage:  /usr/bin/python3 validation/transient_pictures.py [--spp N] [--res WxH] 
 """
 import argparse
 import os
-import struct
 import subprocess
 import tempfile
-import zlib
 
 import numpy as np
 from PIL import Image, ImageDraw
+
+from exr_reader import read_exr
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 NIMBUS = os.environ.get("NIMBUS", os.path.join(ROOT, "build", "bin", "nimbus"))
 IMAGES = os.path.join(ROOT, "docs", "images")
 LOG_K = 100.0  # the frames' and the streak's logarithmic display (to_png)
-
-
-def read_exr(path):
-    """{channel name: H x W float32} of a single-part scanline EXR with ZIP (or no) compression of FLOAT
-    channels, and its string attributes (the OpenEXR file layout: openexr.com, 'OpenEXR File Layout')."""
-    data = open(path, "rb").read()
-    assert struct.unpack_from("<i", data, 0)[0] == 20000630, "not an EXR"
-    pos, channels, attrs = 8, [], {}
-    compression, window = None, None
-    while data[pos] != 0:
-        name_end = data.index(b"\0", pos)
-        name = data[pos:name_end].decode()
-        type_end = data.index(b"\0", name_end + 1)
-        kind = data[name_end + 1:type_end].decode()
-        size = struct.unpack_from("<i", data, type_end + 1)[0]
-        value = data[type_end + 5:type_end + 5 + size]
-        if name == "channels":
-            p = 0
-            while value[p] != 0:
-                e = value.index(b"\0", p)
-                ptype = struct.unpack_from("<i", value, e + 1)[0]
-                assert ptype == 2, "only FLOAT channels"
-                channels.append(value[p:e].decode())
-                p = e + 17
-        elif name == "compression":
-            compression = value[0]
-        elif name == "dataWindow":
-            window = struct.unpack("<4i", value)
-        elif kind == "string":
-            attrs[name] = value.decode()
-        pos = type_end + 5 + size
-    pos += 1
-    x0, y0, x1, y1 = window
-    w, h = x1 - x0 + 1, y1 - y0 + 1
-    lines = 16 if compression == 3 else 1
-    assert compression in (0, 3), "only ZIP or no compression"
-    chunks = (h + lines - 1) // lines
-    offsets = struct.unpack_from(f"<{chunks}Q", data, pos)
-    out = {c: np.zeros((h, w), np.float32) for c in channels}
-    for off in offsets:
-        y, size = struct.unpack_from("<ii", data, off)
-        raw = data[off + 8:off + 8 + size]
-        n = min(lines, y1 + 1 - y)
-        expected = n * w * 4 * len(channels)
-        if size < expected:
-            t = np.frombuffer(zlib.decompress(raw), np.uint8).astype(np.int32)
-            t = np.cumsum(np.concatenate([t[:1], t[1:] - 128])) & 0xFF  # undo the predictor
-            t = t.astype(np.uint8)
-            half = (len(t) + 1) // 2
-            raw = np.empty_like(t)
-            raw[0::2], raw[1::2] = t[:half], t[half:]  # undo the byte interleaving
-            raw = raw.tobytes()
-        rows = np.frombuffer(raw, np.float32).reshape(n, len(channels), w)
-        for k, c in enumerate(channels):
-            out[c][y - y0:y - y0 + n] = rows[:, k]
-    return out, attrs
 
 
 def srgb(x):

@@ -25,11 +25,13 @@ import os
 import resource
 import statistics
 import subprocess
-import struct
+import sys
 import tempfile
-import zlib
 
 import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from exr_reader import read_exr  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
@@ -105,57 +107,9 @@ def read_pfm(path):
 
 
 def read_exr_rgb(path):
-    """H x W x 3 float64 (R, G, B) of a single-part scanline EXR with ZIP or no compression, as nimbus
-    writes it (FLOAT colour channels beside UINT resume-state channels; the OpenEXR file layout:
-    openexr.com, 'OpenEXR File Layout')."""
-    data = open(path, "rb").read()
-    assert struct.unpack_from("<i", data, 0)[0] == 20000630, "not an EXR"
-    pos, channels, compression, window = 8, [], None, None
-    while data[pos] != 0:
-        name_end = data.index(b"\0", pos)
-        name = data[pos:name_end].decode()
-        type_end = data.index(b"\0", name_end + 1)
-        size = struct.unpack_from("<i", data, type_end + 1)[0]
-        value = data[type_end + 5:type_end + 5 + size]
-        if name == "channels":
-            p = 0
-            while value[p] != 0:
-                e = value.index(b"\0", p)
-                channels.append((value[p:e].decode(), struct.unpack_from("<i", value, e + 1)[0]))
-                p = e + 17
-        elif name == "compression":
-            compression = value[0]
-        elif name == "dataWindow":
-            window = struct.unpack("<4i", value)
-        pos = type_end + 5 + size
-    pos += 1
-    assert compression in (0, 3), "only ZIP or no compression"
-    x0, y0, x1, y1 = window
-    w, h = x1 - x0 + 1, y1 - y0 + 1
-    lines = 16 if compression == 3 else 1
-    kinds = {0: "<u4", 1: "<f2", 2: "<f4"}
-    line_bytes = sum(w * np.dtype(kinds[t]).itemsize for _, t in channels)
-    offsets = struct.unpack_from(f"<{(h + lines - 1) // lines}Q", data, pos)
-    rgb = np.zeros((h, w, 3))
-    for off in offsets:
-        y, size = struct.unpack_from("<ii", data, off)
-        raw = data[off + 8:off + 8 + size]
-        n = min(lines, y1 + 1 - y)
-        if size < n * line_bytes:
-            t = np.frombuffer(zlib.decompress(raw), np.uint8).astype(np.int32)
-            t = (np.cumsum(np.concatenate([t[:1], t[1:] - 128])) & 0xFF).astype(np.uint8)  # the predictor
-            half = (len(t) + 1) // 2
-            raw = np.empty_like(t)
-            raw[0::2], raw[1::2] = t[:half], t[half:]  # the byte interleaving
-            raw = raw.tobytes()
-        for r in range(n):
-            p = r * line_bytes
-            for c, t in channels:
-                dt = np.dtype(kinds[t])
-                if c in ("R", "G", "B"):
-                    rgb[y - y0 + r, :, "RGB".index(c)] = np.frombuffer(raw, dt, w, p)
-                p += w * dt.itemsize
-    return rgb
+    """H x W x 3 float64 (R, G, B) of a nimbus EXR (validation/exr_reader.py)."""
+    channels, _ = read_exr(path)
+    return np.stack([channels[c] for c in "RGB"], axis=-1).astype(np.float64)
 
 
 def run_cpu(cmd):
