@@ -170,14 +170,31 @@ std::vector<std::string> scene_overrides(const RenderArgs& args) {
   return sets;
 }
 
+// --integrator NAME naming another integrator than the document's: its block becomes NAME's defaults
+// (keeping spp, seed and max_events, which every integrator has), as the library's switch would make
+// it, but before the --set overrides, so that `--integrator mfs --set integrator.photons=...` sets
+// mfs's field instead of being checked against the scene's integrator.
+void switch_integrator(nlohmann::json& doc, const std::string& name) {
+  if (!doc.is_object()) return;  // the parser names what is wrong with the document
+  const nlohmann::json old = doc.contains("integrator") ? doc["integrator"] : nlohmann::json::object();
+  if (!old.is_object() || (old.contains("type") && !old["type"].is_string())) return;  // likewise
+  if (old.value("type", IntegratorSettings().type) == name) return;
+  nlohmann::json block = {{"type", name}};
+  for (const char* key : {"spp", "seed", "max_events"})
+    if (old.contains(key)) block[key] = old[key];
+  doc["integrator"] = std::move(block);
+}
+
 Scene load_render_scene(const RenderArgs& args) {
   const std::vector<std::string> sets = scene_overrides(args);
-  if (!args.frame) {
+  if (!args.frame && !args.integrator) {
     if (!args.scene.empty()) return load_scene(args.scene, sets);
     if (sets.empty()) return builtin_demo_scene();
   }
-  // The document, its overrides, then (a frame of a sequence) $F in every string: file names and all.
+  // The document, the integrator switch, its overrides, then (a frame of a sequence) $F in every
+  // string: file names and all.
   nlohmann::json doc = args.scene.empty() ? builtin_demo_document() : read_scene_document(args.scene);
+  if (args.integrator) switch_integrator(doc, *args.integrator);
   for (const std::string& o : sets) apply_scene_override(doc, o);
   if (args.frame) substitute_frame(doc, *args.frame);
   if (args.scene.empty()) return parse_scene(doc, "(built-in demo)", ".");

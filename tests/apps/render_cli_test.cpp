@@ -9,6 +9,8 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <nlohmann/json.hpp>
 #include <thread>
 
 #include "nimbus/image.h"
@@ -181,6 +183,39 @@ TEST(RenderCli, ConvertWritesAPngAndRejectsBadInput) {
   EXPECT_EQ(run_render("render " + (dir / "s.json").string() + " -o " + (dir / "c.exr").string() +
                        " --integrator mfs --quiet"),
             0);
+}
+
+// --integrator switches before --set applies, so the switched-to integrator's own fields can be set;
+// the scene's spp stays; a field the integrator does not know is still refused, naming it.
+TEST(RenderCli, SetActsOnTheIntegratorThatIntegratorNames) {
+  const test::ScratchDir scratch("render_cli_switch");
+  const fs::path& dir = scratch.path;
+  write_render_scene(dir / "s.json", 8, 1);
+  const std::string scene = "render " + (dir / "s.json").string();
+  ASSERT_EQ(run_render(scene + " -o " + (dir / "m.exr").string() +
+                       " --integrator mfs --set integrator.scatter_grid_resolution=8"
+                       " --set integrator.photons=2000 --quiet"),
+            0);
+  ImageMetadata meta;
+  read_exr(dir / "m.exr", &meta);
+  EXPECT_EQ(meta_value(meta, "nimbus/integrator"), "mfs");
+  EXPECT_EQ(meta_value(meta, "nimbus/spp"), "1");
+  const auto settings = nlohmann::json::parse(meta_value(meta, "nimbus/integrator_settings"));
+  EXPECT_EQ(settings.at("scatter_grid_resolution"), 8);
+  EXPECT_EQ(settings.at("photons"), 2000);
+  // pathtrace has no scatter grid: refused with the field named, nothing written.
+  const std::string err = (dir / "err.txt").string();
+  EXPECT_EQ(run_render(scene + " -o " + (dir / "p.exr").string() +
+                       " --integrator pathtrace --set integrator.scatter_grid_resolution=8 --quiet 2>" + err),
+            2);
+  EXPECT_FALSE(fs::exists(dir / "p.exr"));
+  std::ifstream in(err);
+  const std::string message((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(message.find("scatter_grid_resolution"), std::string::npos) << message;
+  // Without --integrator the field is checked against the scene's integrator (pathtrace), as before.
+  EXPECT_EQ(run_render(scene + " -o " + (dir / "q.exr").string() +
+                       " --set integrator.scatter_grid_resolution=8 --quiet 2>/dev/null"),
+            2);
 }
 
 }  // namespace
