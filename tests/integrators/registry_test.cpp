@@ -72,6 +72,7 @@ TEST(Registry, SettingsRoundTripThroughJson) {
                                               {"light_blur", false},
                                               {"path_lengthening", true},
                                               {"filtered_lookups", true},
+                                              {"source_blur", true},
                                               {"shadow_map_resolution", 32}});
   expect_round_trip(
       &mfs_settings_from_json,
