@@ -85,7 +85,7 @@ TEST(Registry, DefaultsAreWrittenOut) {
   EXPECT_EQ(mfs["large_angle_scatters"], "all");
   EXPECT_EQ(mfs["scatter_grid_resolution"], "auto");
   EXPECT_EQ(mfs["light_path"], "forward");
-  EXPECT_EQ(mfs.size(), 16u);  // every option of the table in mfs.h
+  EXPECT_EQ(mfs.size(), 17u);  // every option of the table in mfs.h
 }
 
 TEST(Registry, UnknownFieldsAndNamesAreErrors) {
