@@ -41,6 +41,7 @@ MfsSettings mfs_settings_from_json(const nlohmann::json& options, const std::str
   s.light_blur = o.boolean("light_blur", s.light_blur);
   s.path_lengthening = o.boolean("path_lengthening", s.path_lengthening);
   s.filtered_lookups = o.boolean("filtered_lookups", s.filtered_lookups);
+  s.source_blur = o.boolean("source_blur", s.source_blur);
   s.shadow_map_resolution = int(o.integer("shadow_map_resolution", 8, 1024, s.shadow_map_resolution));
   o.finish();
   // The light side carries the light to every scatter through peak scatters, with photons in the true
@@ -67,6 +68,7 @@ nlohmann::json to_json(const MfsSettings& s) {
                       {"light_blur", s.light_blur},
                       {"path_lengthening", s.path_lengthening},
                       {"filtered_lookups", s.filtered_lookups},
+                      {"source_blur", s.source_blur},
                       {"shadow_map_resolution", s.shadow_map_resolution}};
   j["peak_fraction"] = s.peak_fraction ? nlohmann::json(*s.peak_fraction) : nlohmann::json("auto");
   j["large_angle_scatters"] =
@@ -159,7 +161,8 @@ Rgb MfsIntegrator::trace(const Ray& ray, Rng& rng, CameraSample* sample, int bou
   Rgb L(0.0);
   CameraPath cam;  // from the camera to the current step: T_full, T_red, tau_p, theta_p, tau_red, m0..m2
   const double jitter = rng.uniform();
-  MediumPoint mp;
+  MediumPoint mp, mp_blur;
+  const bool blur = s_.source_blur && !s_.light_side();  // forward_side "light" has no camera-side spread
   MarchRecorder layers(sample);  // direct: the lights' light that took at most one wide scatter
   Rgb direct(0.0);
   march_growing(
@@ -175,17 +178,18 @@ Rgb MfsIntegrator::trace(const Ray& ray, Rng& rng, CameraSample* sample, int bou
         // Add what each medium scatters towards the camera at the sample point y = p.
         if (max_component(mp.sigma_s) > 0.0) {
           const CameraPoint y = cam.at(k, jitter, dt, s_.light_side(), s_.path_lengthening);
-          Rgb in_scatter(0.0), peak_scatter(0.0), lights_scatter(0.0);  // via y.T_cam / y.T_full
-          for (int i = 0; i < mp.count; ++i) {
-            if (max_component(mp.sigma_s_i[i]) <= 0.0) continue;
-            const MediumRadiance Lm = medium_radiance(i, p, d, t, y, cam, rng);
-            in_scatter += mp.sigma_s_i[i] * Lm.L;
-            peak_scatter += mp.sigma_s_i[i] * Lm.L_peak;
-            lights_scatter += mp.sigma_s_i[i] * Lm.L_lights;
+          Sources src;  // via y.T_cam / y.T_full
+          add_sources(mp, p, d, t, y, cam, rng, !blur, true, &src);
+          if (blur) {
+            // T_cam's light left its last scatter in the lateral footprint of depth t (eq. D14): the source
+            // there, zero outside the media. The forward peak alone (T_full) goes straight: read at p.
+            const Vec3 ps = p + lateral_offset(d, cam.lateral_spread(t), rng.uniform(), rng.uniform());
+            ctx_.media.eval(ps, &mp_blur);
+            add_sources(mp_blur, ps, d, t, y, cam, rng, true, false, &src);
           }
-          L_step = (y.T_cam * in_scatter + y.T_full * peak_scatter) * dt;
+          L_step = (y.T_cam * src.in_scatter + y.T_full * src.peak_scatter) * dt;
           L += L_step;
-          direct += (y.T_cam * lights_scatter + y.T_full * peak_scatter) * dt;
+          direct += (y.T_cam * src.lights_scatter + y.T_full * src.peak_scatter) * dt;
         }
         // Advance the camera-side state over the whole step.
         const Rgb T0 = s_.light_side() ? cam.T_full : cam.T_red;
@@ -209,6 +213,18 @@ Rgb MfsIntegrator::trace(const Ray& ray, Rng& rng, CameraSample* sample, int bou
                                      bounces > 0 ? &gather : nullptr, &surface_direct, kSurfaceShadowStep);
   layers.finish(ctx_, d, on_surface ? Rgb(0.0) : T_end, direct + surface_direct);
   return L + L_end;
+}
+
+void MfsIntegrator::add_sources(const MediumPoint& m, const Vec3& p, const Vec3& d, double t,
+                                const CameraPoint& y, const CameraPath& cam, Rng& rng, bool scattered,
+                                bool peak, Sources* out) const {
+  for (int i = 0; i < m.count; ++i) {
+    if (max_component(m.sigma_s_i[i]) <= 0.0) continue;
+    const MediumRadiance Lm = medium_radiance(i, p, d, t, y, cam, rng);
+    if (scattered) out->in_scatter += m.sigma_s_i[i] * Lm.L;
+    if (peak) out->peak_scatter += m.sigma_s_i[i] * Lm.L_peak;
+    if (scattered) out->lights_scatter += m.sigma_s_i[i] * Lm.L_lights;
+  }
 }
 
 MfsIntegrator::MediumRadiance MfsIntegrator::medium_radiance(int i, const Vec3& p, const Vec3& d, double t,

@@ -44,6 +44,7 @@
 // | `light_blur`              | boolean                       | true      | the first wide scatter sees the beam's light-side angular spread |
 // | `path_lengthening`        | boolean                       | false     | the corrected kernel's 1 / cosh loss on paths lengthened by peak deflections |
 // | `filtered_lookups`        | boolean                       | false     | scatter grid read pre-filtered over the camera-side lateral spread |
+// | `source_blur`             | boolean                       | false     | the source (sigma_s times every scattered term) read at a point drawn from the camera-side lateral footprint (D10), so rays near a boundary gather partly outside the medium |
 // | `shadow_map_resolution`   | integer in [8, 1024]          | 64        | deep shadow map nodes along the longest axis |
 //
 // forward_side "light" needs light_path "forward" and photon_transport "exact": the other values are
@@ -85,6 +86,7 @@ struct MfsSettings {
   bool light_blur = true;
   bool path_lengthening = false;
   bool filtered_lookups = false;
+  bool source_blur = false;
   int shadow_map_resolution = 64;
 
   bool forward_light_path() const { return light_path == LightPath::forward; }
@@ -131,6 +133,13 @@ class MfsIntegrator final : public Integrator {
     Rgb L_peak;    // the forward-peak-only paths (light_path "forward"), through CameraPoint::T_full
     Rgb L_lights;  // the part of L straight from the lights (no scatter grid): the `direct` layer
   };
+  // What the media at m (evaluated at p) send towards the camera, summed over the media and weighted by
+  // sigma_s_i: the parts through T_cam (scattered) and the forward peak through T_full (peak).
+  struct Sources {
+    Rgb in_scatter{0.0}, peak_scatter{0.0}, lights_scatter{0.0};
+  };
+  void add_sources(const MediumPoint& m, const Vec3& p, const Vec3& d, double t, const CameraPoint& y,
+                   const CameraPath& cam, Rng& rng, bool scattered, bool peak, Sources* out) const;
   // What medium i sends towards the camera from the sample point p (at distance t) of the march: one
   // sample of every light (eqs. D7, D11) and the scatter grid's higher orders (eq. D12).
   MediumRadiance medium_radiance(int i, const Vec3& p, const Vec3& d, double t, const CameraPoint& y,

@@ -77,6 +77,13 @@ double CameraPath::lateral_spread(double t) const {
   return std::sqrt(std::max(0.0, t * t * m0 - 2.0 * t * m1 + m2));
 }
 
+Vec3 lateral_offset(const Vec3& d, double sigma, double u1, double u2) {
+  if (!(sigma > 0.0)) return Vec3(0.0);
+  const double r = sigma * std::sqrt(-2.0 * std::log(1.0 - u1)), phi = 2.0 * kPi * u2;
+  const Frame fr(d);
+  return fr.s * (r * std::cos(phi)) + fr.t * (r * std::sin(phi));
+}
+
 LightBeam peak_only_beam(const Rgb& T_light, const Rgb& T_wide, bool traced, const Rgb& R,
                          const Rgb& mean_cos, const std::vector<double>& peak_moments, double theta2,
                          bool lengthening) {

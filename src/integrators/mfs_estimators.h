@@ -58,6 +58,10 @@ struct CameraPath {
   double lateral_spread(double t) const;
 };
 
+// A point of the lateral footprint around the camera ray (direction d) at standard deviation sigma per
+// component (eq. D10): a 2-D Gaussian offset perpendicular to d by Box-Muller from u1, u2 (eq. D14).
+Vec3 lateral_offset(const Vec3& d, double sigma, double u1, double u2);
+
 // One light's peak-only beam at y (light that has taken no wide scatter yet; eqs. D6, D8, D9).
 struct LightBeam {
   Rgb T_light;  // plain transmittance to the light (shadow map)

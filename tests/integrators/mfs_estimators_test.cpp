@@ -6,6 +6,7 @@
 
 #include <cmath>
 
+#include "core/rng.h"
 #include "transport/small_angle.h"
 
 namespace nimbus {
@@ -106,6 +107,33 @@ TEST(MfsEstimators, EstimatorsAreTheirFormulas) {  // eqs. D7, D7b, D11
   // No spread on either side: the light side's scatter is the phase function itself.
   const Rgb at0 = light_side_scatter(Rgb(1.0), f, split, mu, Rgb(0.0), Rgb(1.0));
   EXPECT_NEAR(at0[0], phase_eval(phase, mu), 0.03 * phase_eval(phase, mu) + 1e-3);
+}
+
+TEST(MfsEstimators, LateralOffsetIsAPerpendicularGaussian) {  // eq. D14
+  const Vec3 d = normalize(Vec3(0.3, -1.0, 0.4));
+  EXPECT_EQ(lateral_offset(d, 0.0, 0.3, 0.7), Vec3(0.0));
+  const Frame fr(d);
+  const double sigma = 0.3;
+  const int n = 40000;
+  double ss = 0.0, tt = 0.0, st = 0.0, ms = 0.0, mt = 0.0, inside = 0.0;
+  Rng rng(11, 3);
+  for (int i = 0; i < n; ++i) {
+    const Vec3 v = lateral_offset(d, sigma, rng.uniform(), rng.uniform());
+    EXPECT_NEAR(dot(v, d), 0.0, 1e-12);
+    const double a = dot(v, fr.s), b = dot(v, fr.t);
+    ms += a, mt += b, ss += a * a, tt += b * b, st += a * b;
+    inside += (a * a + b * b < sigma * sigma) ? 1.0 : 0.0;
+  }
+  // Per-component variance sigma^2, uncorrelated, zero mean (5 standard errors); the 2-D Gaussian puts
+  // 1 - exp(-1/2) of its weight within sigma of the axis.
+  const double v = sigma * sigma, se_v = v * std::sqrt(2.0 / n), se_m = sigma / std::sqrt(double(n));
+  EXPECT_NEAR(ss / n, v, 5 * se_v);
+  EXPECT_NEAR(tt / n, v, 5 * se_v);
+  EXPECT_NEAR(st / n, 0.0, 5 * v / std::sqrt(double(n)));
+  EXPECT_NEAR(ms / n, 0.0, 5 * se_m);
+  EXPECT_NEAR(mt / n, 0.0, 5 * se_m);
+  const double p_in = 1.0 - std::exp(-0.5);
+  EXPECT_NEAR(inside / n, p_in, 5 * std::sqrt(p_in * (1 - p_in) / n));
 }
 
 }  // namespace

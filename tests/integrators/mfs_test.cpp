@@ -477,6 +477,54 @@ TEST(Mfs, FilteredLookupsOfTheScatterGrid) {
   EXPECT_NE(filtered[0], plain[0]);
 }
 
+// source_blur (eq. D14) reads the source over the camera-side lateral footprint. Far from any boundary,
+// in a slab lit uniformly across, the footprint sees the same source: the image is unchanged up to the
+// scatter grid's noise. A backlit sphere's rim, whose footprint lies partly outside, must lose light,
+// and more than its centre does (measured: slab +0.2 %; rim -6.5 %, centre -1.9 %).
+TEST(Mfs, SourceBlurKeepsASlabAndDarkensARim) {
+  Scene slab = test::scene_from_json("{" + test::camera_json(16, 16, 8.0) + R"(,
+    "media": [{"shape": {"type": "box", "min": [-8, -1, -8], "max": [8, 1, 8]}, "sigma_s": 5.0, "sigma_a": 0.05,
+               "phase": {"type": "hg", "g": 0.85}}],
+    "lights": [{"type": "directional", "direction": [0.2, -1, 0.25], "irradiance": 1.0}]})");
+  slab.integrator.type = "mfs";
+  slab.integrator.spp = 4;
+  const Rgb plain = image_mean(render(slab, RenderOptions{}).image);
+  slab.integrator.options = {{"source_blur", true}};
+  const Rgb blurred = image_mean(render(slab, RenderOptions{}).image);
+  std::printf("slab: source_blur %.5f, plain %.5f\n", blurred[0], plain[0]);
+  EXPECT_NEAR(blurred[0], plain[0], 0.02 * plain[0]);
+  EXPECT_NE(blurred[0], plain[0]);  // the option is read
+
+  const int res = 32;
+  Scene sphere = test::scene_from_json("{" + test::camera_json(res, res, 35.0, 4.0) + R"(,
+    "media": [{"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1}, "sigma_s": 9.9, "sigma_a": 0.1,
+               "phase": {"type": "hg", "g": 0.85}}],
+    "lights": [{"type": "directional", "direction": [0.2, -1, 0.25], "irradiance": 1.0}]})");
+  sphere.integrator.type = "mfs";
+  sphere.integrator.spp = 8;
+  // Sums of luminance over the centre (impact parameter b < 0.5 of the projected radius) and the rim
+  // (0.85 <= b < 1).
+  auto rings = [&](const Image& im, double* centre, double* rim) {
+    const double rp = std::tan(std::asin(0.25)) / std::tan(35.0 * kPi / 360.0) * res / 2;
+    *centre = *rim = 0.0;
+    for (int y = 0; y < res; ++y)
+      for (int x = 0; x < res; ++x) {
+        const double b = std::hypot(x + 0.5 - res / 2, y + 0.5 - res / 2) / rp;
+        const float* px = im.pixel(x, y);
+        const double l = 0.2126 * px[0] + 0.7152 * px[1] + 0.0722 * px[2];
+        if (b < 0.5) *centre += l;
+        if (b >= 0.85 && b < 1.0) *rim += l;
+      }
+  };
+  double c0, r0, c1, r1;
+  rings(render(sphere, RenderOptions{}).image, &c0, &r0);
+  sphere.integrator.options = {{"source_blur", true}};
+  rings(render(sphere, RenderOptions{}).image, &c1, &r1);
+  std::printf("sphere: rim %.4f -> %.4f, centre %.4f -> %.4f\n", r0, r1, c0, c1);
+  EXPECT_LT(r1, 0.97 * r0);
+  EXPECT_LT(r1 / r0, c1 / c0 - 0.02);
+}
+
 // A point light (inside the media's bounding sphere, so photons leave it in every direction) and
 // chromatic coefficients (one photon pass per channel): isotropic scattering, all orders, against the
 // path tracer.
