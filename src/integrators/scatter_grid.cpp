@@ -256,10 +256,12 @@ ScatterGrid::ScatterGrid(const SceneContext& ctx, const std::vector<const PhaseS
     return;
   }
   grid_ = node_grid_padded(media_bounds, s.resolution > 0 ? s.resolution : 32);
-  values_.assign(grid_.size() * 3 * coeffs_, 0.0f);
   // With K = 1 only the environment's unscattered-by-wide light is needed (see the header).
-  if (s.max_wide_scatters == 1 && !ctx.has_environment && !ctx.media.emits()) return;
-  trace(ctx, splits, peak_fraction, s);
+  if (!(s.max_wide_scatters == 1 && !ctx.has_environment && !ctx.media.emits()))
+    trace(ctx, splits, peak_fraction, s);
+  // No photons: zero. (Not filled before tracing: the photons' sum replaces values_, and a zero-fill of
+  // the 10 MB grid was a measurable part of the set-up's page faults; issue 12.)
+  if (values_.empty()) values_.assign(grid_.size() * 3 * coeffs_, 0.0f);
 }
 
 void ScatterGrid::trace(const SceneContext& ctx, const std::vector<const PhaseSplit*>& splits,
@@ -301,7 +303,7 @@ void ScatterGrid::trace(const SceneContext& ctx, const std::vector<const PhaseSp
           s.exact_transport ? 1.0 : majorant_share(ctx.media, [&](int i) { return 1.0 - peak_fraction[i]; })};
   // The batches' sums divided by the node volume: fluence and flux.
   values_ = trace_photons(
-      total, s.seed ^ 0x6d756c7469706c65ull, values_.size(), 1.0 / grid_.cell_volume(),
+      total, s.seed ^ 0x6d756c7469706c65ull, grid_.size() * 3 * coeffs_, 1.0 / grid_.cell_volume(),
       [&](size_t j, Rng& rng, PhotonBatch& batch) { photons.trace(j, rng, batch); }, &rejection_failures_);
   build_mips();
 }
