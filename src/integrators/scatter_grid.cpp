@@ -23,28 +23,17 @@ constexpr double kDepositStep = 1.0;
 constexpr int kMaxWideScatters = 1024;  // photons are ended after this many wide scatters (or
                                         // kMaxPhotonEvents real collisions)
 
-// Adds the per-node values `add` (count floats, node offset `first`) times the trilinear weights of st
-// to the tally's nodes. One flight's values are the same at every sample: they are computed once, in
-// float, and the node loop is a contiguous multiply-add the compiler vectorises.
-void splat(float* tally, const TrilinearStencil& st, int floats_per_node, int first, int count,
+// Adds the per-node values `add` (count floats, node offset `first`) times the trilinear weights at q
+// to the tally's nodes around q. One flight's values are the same at every sample: they are computed
+// once, in float, and the node loop is a contiguous multiply-add the compiler vectorises.
+void splat(float* tally, const NodeGrid& grid, int floats_per_node, int first, int count, const Vec3& q,
            const float* add) {
+  const TrilinearStencil st = grid.stencil(q);
   for (int k = 0; k < 8; ++k) {
     const float wt = float(st.weight[k]);
     if (wt <= 0.0f) continue;
     float* node = &tally[st.node[k] * floats_per_node + first];
     for (int i = 0; i < count; ++i) node[i] += wt * add[i];
-  }
-}
-
-// Asks for the cache lines of st's nodes (floats [first, first + count) of each): the deposits wait on
-// the tally's memory (10 MB on the Disney cloud), so the next sample's nodes are fetched while this one
-// is added.
-void prefetch(const float* tally, const TrilinearStencil& st, int floats_per_node, int first, int count) {
-  for (int k = 0; k < 8; k += 2) {  // nodes k and k + 1 are neighbours along x: one run of memory
-    const char* lo = reinterpret_cast<const char*>(&tally[st.node[k] * floats_per_node + first]);
-    const char* hi = reinterpret_cast<const char*>(&tally[st.node[k + 1] * floats_per_node + first + count]);
-    for (const char* a = lo; a < hi; a += 64) __builtin_prefetch(a, 1);
-    __builtin_prefetch(hi - 1, 1);
   }
 }
 
@@ -72,17 +61,8 @@ void deposit_flight(float* tally, const NodeGrid& grid, int bands, const Vec3& x
   for (int c = c_lo; c <= c_hi; ++c)
     for (int h = 0; h < coeffs; ++h) add[coeffs * (c - c_lo) + h] = float(v[c] * y[h]);
   const int first = coeffs * c_lo, count = coeffs * (c_hi - c_lo + 1);
-  TrilinearStencil st = grid.stencil(x + w * (t0 + 0.5 * len / n));
-  for (int k = 0; k < n; ++k) {
-    const bool more = k + 1 < n;
-    TrilinearStencil next;
-    if (more) {
-      next = grid.stencil(x + w * (t0 + (k + 1.5) * len / n));
-      prefetch(tally, next, 3 * coeffs, first, count);
-    }
-    splat(tally, st, 3 * coeffs, first, count, add);
-    if (more) st = next;
-  }
+  for (int k = 0; k < n; ++k)
+    splat(tally, grid, 3 * coeffs, first, count, x + w * (t0 + (k + 0.5) * len / n), add);
 }
 
 // The next pre-filtered level: the values (`floats` per node) of `fine` at its nodes 2j, filtered with
