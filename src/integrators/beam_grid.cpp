@@ -21,8 +21,7 @@ constexpr double kDepositStep = 0.5;  // roulette below this ratio of weight to 
 
 // Adds v (channel ch) with trilinear weights st to the tally: to the straight column, or to the traced
 // one and (times mu) the traced x cosine one.
-void splat(std::vector<float>& tally, const TrilinearStencil& st, int ch, double v, double mu,
-           bool straight) {
+void splat(float* tally, const TrilinearStencil& st, int ch, double v, double mu, bool straight) {
   for (int j = 0; j < 8; ++j)
     if (st.weight[j] > 0.0) {
       float* node = &tally[st.node[j] * kFloats];
@@ -62,7 +61,7 @@ struct BeamPhotons {
   double majorant_scale;  // the share of the majorant that bounds the peak-scatter rate
 
   void trace(size_t j, Rng& rng, PhotonBatch& batch) const;
-  Rgb deposit(std::vector<float>& tally, const Vec3& x, const Vec3& w, double t_end, Rgb weight, int c,
+  Rgb deposit(float* tally, const Vec3& x, const Vec3& w, double t_end, Rgb weight, int c,
               bool straight) const;
   bool scatter(const Vec3& xc, Vec3* w, BeamWalk& walk, Rng& rng, PhotonBatch& batch) const;
 };
@@ -71,8 +70,8 @@ struct BeamPhotons {
 // `weight` (channel c only unless grey) and losing exp(-int sigma_loss) along the way (midpoint
 // rule at the deposit samples); each sample divided by the straight-line model at that point.
 // Returns the weight at t_end.
-Rgb BeamPhotons::deposit(std::vector<float>& tally, const Vec3& x, const Vec3& w, double t_end, Rgb weight,
-                         int c, bool straight) const {
+Rgb BeamPhotons::deposit(float* tally, const Vec3& x, const Vec3& w, double t_end, Rgb weight, int c,
+                         bool straight) const {
   double t0, t1;
   if (!grid.bounds.intersect(x, w, 0.0, t_end, &t0, &t1) || !(t1 - t0 > 0.0)) return weight;
   const double len = t1 - t0;
@@ -113,7 +112,7 @@ void BeamPhotons::trace(size_t j, Rng& rng, PhotonBatch& batch) const {
   walk.w0 = walk.weight[walk.c];
   // The same photon undeflected: the straight-line model with the same emission (a control
   // variate: R = traced / straight cancels the emission's sampling noise).
-  deposit(batch.tally, ph.x, ph.w, std::numeric_limits<double>::infinity(), walk.weight, walk.c, true);
+  deposit(batch.tally.data(), ph.x, ph.w, std::numeric_limits<double>::infinity(), walk.weight, walk.c, true);
   // Flights end at peak scatters only (rate sum_m f_m sigma_s,m); absorption and wide scatters are the
   // continuous loss exp(-int sigma_loss) on the weight (zero variance in a uniform medium).
   const auto peak_share = [&](int i) { return peak_fraction[i]; };
@@ -124,7 +123,7 @@ void BeamPhotons::trace(size_t j, Rng& rng, PhotonBatch& batch) const {
         return scattering_shares(walk.mp, ctx.media.count(), walk.c, peak_share).sum;
       },
       [&](const Vec3& x, const Vec3& w, double t_end) {
-        walk.weight = deposit(batch.tally, x, w, t_end, walk.weight, walk.c, false);
+        walk.weight = deposit(batch.tally.data(), x, w, t_end, walk.weight, walk.c, false);
       },
       [&](const Vec3& xc, Vec3* w) { return scatter(xc, w, walk, rng, batch); },
       // A reflection is a wide scatter: not part of the forward-peaked beam.

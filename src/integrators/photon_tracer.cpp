@@ -90,7 +90,7 @@ std::vector<float> trace_photons(size_t total, uint64_t stream_seed, size_t tall
   std::vector<double> batch_scale(kPhotonBatches, 1.0);
   tbb::parallel_for(0, kPhotonBatches, [&](int b) {
     PhotonBatch& pb = batch[b];
-    pb.tally.assign(tally_size, 0.0f);
+    pb.tally = ZeroedFloats(tally_size);
     const size_t begin = total * size_t(b) / kPhotonBatches, end = total * size_t(b + 1) / kPhotonBatches;
     const double budget = kEventsPerPhoton * double(end - begin);
     size_t j = begin;

@@ -16,6 +16,7 @@
 #include "core/check.h"
 #include "core/math.h"
 #include "core/rng.h"
+#include "core/zeroed_floats.h"
 #include "integrators/integrator.h"
 #include "integrators/tracking.h"
 #include "media/media.h"
@@ -48,7 +49,7 @@ bool grey_media(const SceneContext& ctx);
 
 // What one batch of photons has written and spent.
 struct PhotonBatch {
-  std::vector<float> tally;         // the grid's per-node sums, laid out as the grid wants
+  ZeroedFloats tally;               // the grid's per-node sums, laid out as the grid wants (zero at start)
   double collisions = 0.0;          // real collisions so far (the work budget's measure)
   uint64_t rejection_failures = 0;  // scatters whose direction sample_by_rejection could not draw
 };

@@ -26,8 +26,8 @@ constexpr int kMaxWideScatters = 1024;  // photons are ended after this many wid
 // Adds the per-node values `add` (count floats, node offset `first`) times the trilinear weights at q
 // to the tally's nodes around q. One flight's values are the same at every sample: they are computed
 // once, in float, and the node loop is a contiguous multiply-add the compiler vectorises.
-void splat(std::vector<float>& tally, const NodeGrid& grid, int floats_per_node, int first, int count,
-           const Vec3& q, const float* add) {
+void splat(float* tally, const NodeGrid& grid, int floats_per_node, int first, int count, const Vec3& q,
+           const float* add) {
   const TrilinearStencil st = grid.stencil(q);
   for (int k = 0; k < 8; ++k) {
     const float wt = float(st.weight[k]);
@@ -41,8 +41,8 @@ void splat(std::vector<float>& tally, const NodeGrid& grid, int floats_per_node,
 // most kDepositStep spacings apart, each splatting its share of power x length times the harmonics of w
 // (per node: channel c at [coeffs c + h], as ScatterGrid::values_; only the channels from the first
 // to the last with non-zero power are touched).
-void deposit_flight(std::vector<float>& tally, const NodeGrid& grid, int bands, const Vec3& x, const Vec3& w,
-                    double t_end, const Rgb& power) {
+void deposit_flight(float* tally, const NodeGrid& grid, int bands, const Vec3& x, const Vec3& w, double t_end,
+                    const Rgb& power) {
   double t0, t1;
   if (!grid.bounds.intersect(x, w, 0.0, t_end, &t0, &t1)) return;
   const double len = t1 - t0;
@@ -155,7 +155,8 @@ void ScatterPhotons::trace(size_t j, Rng& rng, PhotonBatch& batch) const {
         return s.exact_transport ? ctx.media.sigma_t(p)[c] : reduced_sigma_t(ctx.media, p, peak_fraction)[c];
       },
       [&](const Vec3& x, const Vec3& w, double t_end) {
-        if (order >= first_order) deposit_flight(batch.tally, grid, bands, x, w, t_end, power * weight);
+        if (order >= first_order)
+          deposit_flight(batch.tally.data(), grid, bands, x, w, t_end, power * weight);
       },
       [&](const Vec3& xc, Vec3* w) { return scatter(xc, w, c, &weight, &order, rng, batch); },
       [&](const SurfaceHit& hit, Vec3* w) { return reflect(hit, w, c, &weight, &order, rng); });
@@ -235,10 +236,12 @@ ScatterGrid::ScatterGrid(const SceneContext& ctx, const std::vector<const PhaseS
     return;
   }
   grid_ = node_grid_padded(media_bounds, s.resolution > 0 ? s.resolution : 32);
-  values_.assign(grid_.size() * 3 * coeffs_, 0.0f);
   // With K = 1 only the environment's unscattered-by-wide light is needed (see the header).
-  if (s.max_wide_scatters == 1 && !ctx.has_environment && !ctx.media.emits()) return;
-  trace(ctx, splits, peak_fraction, s);
+  if (!(s.max_wide_scatters == 1 && !ctx.has_environment && !ctx.media.emits()))
+    trace(ctx, splits, peak_fraction, s);
+  // No photons: zero. (Not filled before tracing: the photons' sum replaces values_, and a zero-fill of
+  // the 10 MB grid was a measurable part of the set-up's page faults; issue 12.)
+  if (values_.empty()) values_.assign(grid_.size() * 3 * coeffs_, 0.0f);
 }
 
 void ScatterGrid::trace(const SceneContext& ctx, const std::vector<const PhaseSplit*>& splits,
@@ -280,7 +283,7 @@ void ScatterGrid::trace(const SceneContext& ctx, const std::vector<const PhaseSp
           s.exact_transport ? 1.0 : majorant_share(ctx.media, [&](int i) { return 1.0 - peak_fraction[i]; })};
   // The batches' sums divided by the node volume: fluence and flux.
   values_ = trace_photons(
-      total, s.seed ^ 0x6d756c7469706c65ull, values_.size(), 1.0 / grid_.cell_volume(),
+      total, s.seed ^ 0x6d756c7469706c65ull, grid_.size() * 3 * coeffs_, 1.0 / grid_.cell_volume(),
       [&](size_t j, Rng& rng, PhotonBatch& batch) { photons.trace(j, rng, batch); }, &rejection_failures_);
   build_mips();
 }
