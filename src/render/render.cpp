@@ -403,7 +403,8 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
   }
   if (done < settings.spp && !result.time_limited && !adaptive) result.partial = true;
   // Adaptive sampling: passes planned from the film's per-pixel variances (render/adaptive.h).
-  AdaptiveSettings adapt{options.noise, options.noise_bin, 0.05, std::min(8, settings.spp), settings.spp};
+  const AdaptiveSettings adapt{options.noise, options.noise_bin, 0.05, std::min(8, settings.spp),
+                               settings.spp};
   for (int pass = 1; adaptive; ++pass) {
     AdaptivePlan plan = plan_adaptive_pass(film, adaptive_layer, adapt);
     result.noise_estimate = plan.estimated_error;
