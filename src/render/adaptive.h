@@ -1,7 +1,7 @@
 // Adaptive sampling (render --noise): after each pass, a set of probe samples that never enter the image
 // gives each pixel's variance and cost, from them the binned relative RMSE the image would show against a
 // noise-free reference (the metric of nimbus compare --bin K --min-ref 0.05), and how many samples each
-// pixel should have for that error to reach the target. docs/rendering.md explains it.
+// pixel should have for that error to reach the target. docs/cli.md and docs/validation/render.md explain it.
 #pragma once
 
 #include <cstdint>
