@@ -132,18 +132,12 @@ int64_t render_pixel(const Integrator& integrator, const PinholeCamera& camera,
     if (to.deep_samples > 0) sample.deep = &sample_segments;
     timed.clear();
     if (to.time_film) sample.timed = &timed;
-    const uint64_t rng_start = rng.state();
     const Rgb L = integrator.Li(camera.generate_ray(x + jx, y + jy), rng, &sample);
     if (!to.layers.add(to.film, x - to.x0, y - to.y0, L, sample)) {
       ++bad;
       continue;  // a dropped sample adds nothing to the deep pixel (or the time bins) either
     }
     if (to.time_film) to.time_film->add(x - to.x0, y - to.y0, timed);
-    if (to.adaptive_layer >= 0) {  // the luminance the film took (less a transparent film's background)
-      const double lum = luminance(to.layers.beauty(L, sample));
-      const double a[kAdaptiveChannels] = {lum * lum, double(rng.draws_since(rng_start))};
-      to.film.add(to.adaptive_layer, x - to.x0, y - to.y0, a);
-    }
     segments.insert(segments.end(), sample_segments.begin(), sample_segments.end());
   }
   if (to.deep_samples > 0) {
@@ -151,6 +145,32 @@ int64_t render_pixel(const Integrator& integrator, const PinholeCamera& camera,
     merge_deep_segments(segments, 1.0 / settings.spp, to.deep_samples, &(*to.deep_pixels)[i]);
   }
   return bad;
+}
+
+// Adaptive sampling's probe samples [s0, s1) of pixel (x, y) into the adaptive layer (render/adaptive.h):
+// drawn as the image's samples are, from a stream of random numbers the image's never use (and positions
+// in the pixel rotated by an offset of their own), so that nothing the image takes decides its counts.
+void render_probes(const Integrator& integrator, const PinholeCamera& camera,
+                   const IntegratorSettings& settings, int x, int y, int s0, int s1, const PixelTargets& to) {
+  Rng shift = Rng::for_sample(settings.seed, uint32_t(x), uint32_t(y), kProbeIndexBase - 1);
+  const double ux = shift.uniform(), uy = shift.uniform();
+  for (int s = s0; s < s1; ++s) {
+    Rng rng = Rng::for_sample(settings.seed, uint32_t(x), uint32_t(y), kProbeIndexBase + uint64_t(s));
+    double jx = ux + s * kR2a1, jy = uy + s * kR2a2;
+    jx -= std::floor(jx);
+    jy -= std::floor(jy);
+    CameraSample sample;
+    sample.depth_wanted = to.layers.depth_wanted();
+    const uint64_t rng_start = rng.state();
+    const Rgb L = integrator.Li(camera.generate_ray(x + jx, y + jy), rng, &sample);
+    // The luminance the film would take (less a transparent film's background); a non-finite one counts
+    // as a dark sample, as it is dropped from the image.
+    double lum = luminance(to.layers.beauty(L, sample));
+    if (!std::isfinite(lum)) lum = 0.0;
+    double a[kAdaptiveChannels];
+    probe_values(lum, double(rng.draws_since(rng_start)), a);
+    to.film.add(to.adaptive_layer, x - to.x0, y - to.y0, a);
+  }
 }
 
 // The pixels' deep samples as one deep image.
@@ -186,8 +206,9 @@ struct PassContext {
   int64_t total = 0;             // pixel samples to take
   int64_t nonfinite = 0;         // in whole passes
   // Adaptive sampling: each pixel's sample count after the pass (its samples [count, target) are taken);
-  // null: samples [s0, s1) of every pixel.
+  // null: samples [s0, s1) of every pixel. And its probe samples' count after it.
   const std::vector<uint32_t>* target = nullptr;
+  const std::vector<uint32_t>* probe = nullptr;
 };
 
 // Samples [s0, s1) of every pixel, tile by tile over oneTBB. Returns false when stopped part-way (the
@@ -211,8 +232,11 @@ bool render_pass(PassContext& pc, tbb::task_arena& arena, int s0, int s1) {
       for (int x = x0; x < x1; ++x) {
         int a = s0, b = s1;
         if (pc.target) {
+          const size_t i = size_t(y - Y0) * size_t(W) + size_t(x - X0);
           a = int(pc.targets.film.samples(x - X0, y - Y0));
-          b = int((*pc.target)[size_t(y - Y0) * size_t(W) + size_t(x - X0)]);
+          b = int((*pc.target)[i]);
+          const int p0 = int(probe_count(pc.targets.film, pc.targets.adaptive_layer, x - X0, y - Y0));
+          render_probes(pc.integrator, pc.camera, pc.settings, x, y, p0, int((*pc.probe)[i]), pc.targets);
         }
         tile_bad += render_pixel(pc.integrator, pc.camera, pc.settings, x, y, a, b, pc.targets);
         tile_samples += b - a;
@@ -301,6 +325,11 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
   if (options.layers) film_settings.layers = *options.layers;
   const FilmLayers layers(film, film_settings, context->has_environment);
   const bool adaptive = options.noise > 0.0;
+  if (options.resume && std::any_of(options.resume->layers.begin(), options.resume->layers.end(),
+                                    [](const FilmState::Layer& l) { return l.name == kAdaptiveLayerV1; }))
+    throw Error(
+        "resume: the image is an adaptive render of an earlier nimbus, whose passes its own samples "
+        "decided; it cannot be continued (render it again)");
   const bool resumed_adaptive =
       options.resume && std::any_of(options.resume->layers.begin(), options.resume->layers.end(),
                                     [](const FilmState::Layer& l) { return l.name == kAdaptiveLayer; });
@@ -381,8 +410,9 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
     result.noise_estimate = plan.estimated_error;
     if (plan.new_samples == 0) break;
     const double per_sample = pass > 1 ? seconds_per_spp / (double(W) * H) : 0.0;
+    const double new_work = double(plan.new_samples + plan.new_probes);
     if (!first && options.time_limit > 0.0 &&
-        !(0.95 * (options.time_limit - seconds_since(start)) >= per_sample * double(plan.new_samples))) {
+        !(0.95 * (options.time_limit - seconds_since(start)) >= per_sample * new_work)) {
       result.time_limited = true;
       break;
     }
@@ -390,6 +420,7 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
       options.setup(fmt::format("adaptive pass {}: noise {:.2f} % (target {:.2f} %)", pass,
                                 100.0 * plan.estimated_error, 100.0 * options.noise));
     pc.target = &plan.target;
+    pc.probe = &plan.probe;
     pc.total = pc.done + plan.new_samples;
     const FilmState before = stoppable ? film.state(done) : FilmState{};
     const std::optional<TimeFilm> time_before = stoppable ? time_film : std::nullopt;
@@ -400,7 +431,7 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
       (cancelled() ? result.partial : result.time_limited) = true;
       break;
     }
-    seconds_per_spp = seconds_since(pass_start) / double(plan.new_samples) * (double(W) * H);
+    seconds_per_spp = seconds_since(pass_start) / new_work * (double(W) * H);  // per sample, probes included
     first = false;
   }
   double count_sum = 0.0;

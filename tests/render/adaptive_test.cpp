@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <cstring>
@@ -19,12 +20,18 @@
 namespace nimbus {
 namespace {
 
-// A grey sample of luminance `value` into pixel (x, y) of a film with the adaptive layer, costing
+// A grey probe sample of luminance `value` into pixel (x, y) of a film with the adaptive layer, costing
 // `draws` random numbers.
+void add_probe(Film& film, int layer, int x, int y, double value, double draws = 0.0) {
+  double a[kAdaptiveChannels];
+  probe_values(value, draws, a);
+  film.add(layer, x, y, a);
+}
+
+// A grey image sample and a probe sample of the same luminance.
 void add_grey(Film& film, int layer, int x, int y, double value, double draws = 0.0) {
   film.add_sample(x, y, Rgb(value, value, value));
-  const double a[kAdaptiveChannels] = {value * value, draws};
-  film.add(layer, x, y, a);
+  add_probe(film, layer, x, y, value, draws);
 }
 
 // Left half: every sample 1 (no variance). Right half: samples alternating 0.5 and 1.5 (variance 1/4
@@ -46,18 +53,17 @@ TEST(Adaptive, EstimateIsTheBinnedRelativeErrorOfTheVariances) {
   s.noise = 0.01;
   s.bin = 2;
   s.max_spp = 1024;
+  s.shrink = 0.0;
+  s.probe_radius = 1;
   const AdaptivePlan plan = plan_adaptive_pass(film, y2, s);
-  // Per-sample variance on the right: n / (4 (n - 1)). Pooled over 3 x 3 neighbours, by column (every
-  // row alike): 0, 0, 0, v/3 (one noisy column of three), 2v/3, v, v, v. A 2 x 2 bin's mean has variance
-  // sum_i v_i / (4 n) / 4; every bin's mean luminance is 1; 4 x 2 bins.
+  // Per-sample variance on the right: n / (4 (n - 1)), each pixel's own (not pooled: a pixel's count
+  // comes from its neighbours, its part in the estimate from itself). A 2 x 2 bin's mean has variance
+  // sum_i v_i / (4 n) / 4; every bin's mean luminance is 1; 4 x 2 bins, the right two columns noisy.
   const double v = n / (4.0 * (n - 1));
-  const double vc[8] = {0, 0, 0, v / 3, 2 * v / 3, v, v, v};
-  double var_sum = 0.0;
-  for (int bx = 0; bx < 4; ++bx) var_sum += 2 * (2 * vc[2 * bx] + 2 * vc[2 * bx + 1]) / (16.0 * n);
-  const double expected = std::sqrt(var_sum / 8.0);
+  const double expected = std::sqrt(4 * (4 * v) / (16.0 * n) / 8.0);
   EXPECT_NEAR(plan.estimated_error, expected, 1e-12 * expected);
-  // Far above 1 %: samples go to the noisy half only (the quiet columns 0-1 keep their 8), at most
-  // doubling each pixel.
+  // Far above 1 %: samples go to the noisy half only (the quiet columns 0-1, whose neighbours are quiet,
+  // keep their 8), at most doubling each pixel.
   for (int y = 0; y < 4; ++y) {
     EXPECT_EQ(plan.target[size_t(y) * 8 + 0], uint32_t(n));
     EXPECT_EQ(plan.target[size_t(y) * 8 + 7], uint32_t(2 * n));
@@ -79,45 +85,54 @@ TEST(Adaptive, TargetsFollowTheStandardDeviation) {
   AdaptiveSettings s;
   s.bin = 1;
   s.max_spp = 1 << 20;
+  s.shrink = 0.0;
+  s.probe_radius = 1;
   s.noise = plan_adaptive_pass(film, y2, s).estimated_error / 1.2;
   const AdaptivePlan plan = plan_adaptive_pass(film, y2, s);
   const double r = double(plan.target[5]) / double(plan.target[4]);
   EXPECT_NEAR(r, std::sqrt(5.0 / 3.0), 0.05);
 }
 
-TEST(Adaptive, APixelsOwnSamplesDoNotDecideItsCount) {
-  // Every pixel alike (samples 0.5 and 1.5), but pixel (3, 3)'s samples all 1 (no variance: "converged")
-  // or one of them 40 (a rare bright path). Its planned count is the one of pixel (5, 5), whose
-  // neighbours are as noisy as its own: had its own samples decided, the quiet pixel would stop (and its
-  // pixels' mean would be biased dark over many renders) and the bright one would take the most.
-  for (const double odd : {1.0, 40.0}) {
+TEST(Adaptive, TheImagesSamplesDecideNothing) {
+  // Every pixel's probe samples alike (0.5 and 1.5); pixel (3, 3)'s image samples all 1 (no variance:
+  // "converged"), or one of them 40 (a rare bright path), or like the others. The plans are the same
+  // whatever the image's samples: had they decided (a pixel's count, the bins' means, the stop), the
+  // quiet pixel would stop and its mean, and the image's, would be biased dark over many renders.
+  auto film_with = [](double odd, double probe_odd) {
     Film film(8, 8);
     const int layer = film.add_layer(kAdaptiveLayer, kAdaptiveChannels);
     for (int y = 0; y < 8; ++y)
       for (int x = 0; x < 8; ++x)
         for (int s = 0; s < 32; ++s) {
-          double value = s % 2 ? 1.5 : 0.5;
-          if (x == 3 && y == 3) value = odd == 1.0 ? 1.0 : (s == 0 ? odd : value);
-          add_grey(film, layer, x, y, value);
+          const double value = s % 2 ? 1.5 : 0.5, v = x == 3 && y == 3 && s == 0 ? odd : value;
+          film.add_sample(x, y, Rgb(v, v, v));
+          const double probe = (s / 4) % 2 ? 1.5 : 0.5;  // a probe sample for every 4 of the image's
+          if (s % 4 == 0) add_probe(film, layer, x, y, x == 3 && y == 3 && s == 0 ? probe_odd : probe);
         }
-    AdaptiveSettings st;
-    st.bin = 1;
-    st.max_spp = 1 << 20;
-    st.noise = plan_adaptive_pass(film, layer, st).estimated_error / 1.2;
-    const AdaptivePlan plan = plan_adaptive_pass(film, layer, st);
-    const uint32_t odd_pixel = plan.target[3 * 8 + 3], far = plan.target[5 * 8 + 5],
-                   beside = plan.target[4 * 8 + 4];
-    EXPECT_EQ(odd_pixel, far) << odd;
-    // The power of the check: the counts follow the variance around them. Pixel (4, 4) has the odd one
-    // among its neighbours: fewer samples beside the quiet pixel, more beside the bright one.
-    if (odd == 1.0) {
-      EXPECT_GT(far, 32u);
-      EXPECT_LT(far, 64u);  // inside the doubling bound
-      EXPECT_LT(beside, far);
-    } else {
-      EXPECT_GT(beside, far);
-    }
+    return film;
+  };
+  AdaptiveSettings st;
+  st.bin = 2;
+  st.max_spp = 1 << 20;
+  const Film plain = film_with(0.5, 0.5);
+  const int layer = plain.layer_index(kAdaptiveLayer);
+  st.noise = plan_adaptive_pass(plain, layer, st).estimated_error / 1.2;
+  const AdaptivePlan ref = plan_adaptive_pass(plain, layer, st);
+  for (const double odd : {1.0, 40.0}) {
+    const AdaptivePlan plan = plan_adaptive_pass(film_with(odd, 0.5), layer, st);
+    EXPECT_EQ(plan.estimated_error, ref.estimated_error) << odd;
+    EXPECT_EQ(plan.target, ref.target) << odd;
+    EXPECT_EQ(plan.probe, ref.probe) << odd;
   }
+  // The power of the check: the counts follow the probe's variance. A bright probe sample at (3, 3)
+  // raises the estimate and the counts around it.
+  const AdaptivePlan bright = plan_adaptive_pass(film_with(0.5, 40.0), layer, st);
+  EXPECT_GT(bright.estimated_error, ref.estimated_error);
+  EXPECT_GT(bright.target[4 * 8 + 4], ref.target[4 * 8 + 4]);
+  EXPECT_GT(ref.target[4 * 8 + 4], 32u);
+  // One probe sample planned for every probe_ratio of the image's.
+  const uint32_t t = ref.target[4 * 8 + 4], q = uint32_t(st.probe_ratio);
+  EXPECT_EQ(ref.probe[4 * 8 + 4], std::max(8u, (t + q - 1) / q));
 }
 
 TEST(Adaptive, CostlierPixelsTakeFewerSamples) {
@@ -134,6 +149,7 @@ TEST(Adaptive, CostlierPixelsTakeFewerSamples) {
   AdaptiveSettings st;
   st.bin = 1;
   st.max_spp = 1 << 20;
+  st.probe_radius = 1;
   st.noise = plan_adaptive_pass(film, layer, st).estimated_error / 1.2;
   const AdaptivePlan plan = plan_adaptive_pass(film, layer, st);
   EXPECT_NEAR(double(plan.target[12 + 2]) / double(plan.target[12 + 9]), 2.0, 0.05);
