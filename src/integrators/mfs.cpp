@@ -263,13 +263,14 @@ MfsIntegrator::MediumRadiance MfsIntegrator::medium_radiance(int i, const Vec3& 
       out.L += light_side_scatter(ls.weight, f, split, mu, beam.tau_ps, beam.T_wide);  // eq. D11
       return;
     }
-    if (s_.large_angle_scatters != 0)  // eq. D7, first term
-      out.L += first_wide_scatter(ls.weight, f, split, mu, y.tau_p, s_.light_blur ? beam.tau_ps : Rgb(0.0),
+    const PhaseSplit::Angle a = PhaseSplit::angle(mu);  // once for both terms
+    if (s_.large_angle_scatters != 0)                   // eq. D7, first term
+      out.L += first_wide_scatter(ls.weight, f, split, a, y.tau_p, s_.light_blur ? beam.tau_ps : Rgb(0.0),
                                   beam.T_wide);
     if (s_.forward_light_path())  // eq. D7, second term: to the camera with T_full
-      out.L_peak += forward_peak(ls.weight, f, split, mu, beam.tau_ps, beam.T_wide);
+      out.L_peak += forward_peak(ls.weight, f, split, a, beam.tau_ps, beam.T_wide);
     else  // eq. D7b (beer_lambert)
-      out.L += forward_peak(ls.weight, f, split, mu, y.tau_p, beam.T_light);
+      out.L += forward_peak(ls.weight, f, split, a, y.tau_p, beam.T_light);
   };
   // Sample every light once (u1, u2, in this order).
   for (size_t l = 0; l < ctx_.lights.size(); ++l) {
