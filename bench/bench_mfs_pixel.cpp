@@ -175,7 +175,7 @@ void BM_MfsPixelSkeleton(benchmark::State& state) {
       uint32_t n = 0;
       march_growing(
           ctx.majorants, ray.o, ray.d, std::numeric_limits<double>::infinity(), s.tau_step, jitter,
-          [&] { return 1.0 + s.step_growth * max_component(cam.tau_red); },
+          [&](double, double) { return 1.0 + s.step_growth * max_component(cam.tau_red); },
           [&](const Vec3& q, double t, double dt) {
             ++n;
             ctx.media.eval(q, &mp);

@@ -1,6 +1,7 @@
 #include "integrators/mfs.h"
 
 #include <fmt/format.h>
+#include <tbb/parallel_for.h>
 
 #include "core/json_reader.h"
 #include "integrators/area_light_view.h"
@@ -18,6 +19,26 @@ const std::vector<std::string> kLightPathNames = {"forward", "beer_lambert"};
 const std::vector<std::string> kPropagatorNames = {"gsa", "gaussian"};
 const std::vector<std::string> kPhotonTransportNames = {"exact", "similarity"};
 const std::vector<std::string> kForwardSideNames = {"camera", "light"};
+
+// Per majorant cell (the grid's order): whether a medium may emit there (SceneMedia::may_emit).
+std::vector<uint8_t> emitting_cells(const SceneContext& ctx) {
+  const auto res = ctx.majorants.resolution();
+  const Bounds b = ctx.majorants.bounds();
+  const Vec3 cell = Vec3((b.hi.x - b.lo.x) / res[0], (b.hi.y - b.lo.y) / res[1], (b.hi.z - b.lo.z) / res[2]);
+  std::vector<uint8_t> emits(size_t(res[0]) * res[1] * res[2], 0);
+  tbb::parallel_for(0, res[2], [&](int z) {
+    for (int y = 0; y < res[1]; ++y)
+      for (int x = 0; x < res[0]; ++x) {
+        Bounds box;
+        box.lo = b.lo + Vec3(x, y, z) * cell;
+        box.hi = box.lo + cell;
+        bool e = false;
+        for (int i = 0; i < ctx.media.count() && !e; ++i) e = ctx.media.may_emit(i, box);
+        emits[(size_t(z) * res[1] + y) * res[0] + x] = e;
+      }
+  });
+  return emits;
+}
 }  // namespace
 
 MfsSettings mfs_settings_from_json(const nlohmann::json& options, const std::string& where) {
@@ -116,6 +137,9 @@ MfsIntegrator::MfsIntegrator(const SceneContext& context, MfsSettings settings, 
     s_.scatter_grid_resolution =
         std::isfinite(across) ? int(std::clamp(std::ceil(across / 1.6), 32.0, 64.0)) : 64;
   }
+  // The majorant cells where a medium may emit march at fixed steps (eq. D13): the growing steps sample
+  // the emission's spatial variation, which no blur smooths, too coarsely.
+  if (ctx_.media.emits() && s_.step_growth > 0.0) emitting_cells_ = emitting_cells(ctx_);
   std::vector<const PhaseSplit*> splits;  // for the photon grids
   for (const auto& sp : splits_) splits.push_back(sp.get());
   if (s_.forward_light_path() && s_.beam_photons > 0 && !ctx_.lights.empty()) {
@@ -136,8 +160,21 @@ MfsIntegrator::MfsIntegrator(const SceneContext& context, MfsSettings settings, 
   }
 }
 
+bool MfsIntegrator::grows(const Vec3& p) const {
+  if (emitting_cells_.empty()) return true;
+  const auto res = ctx_.majorants.resolution();
+  const Bounds& b = ctx_.majorants.bounds();
+  size_t index = 0;
+  for (int a = 2; a >= 0; --a) {
+    const int c = std::clamp(int((p[a] - b.lo[a]) / (b.hi[a] - b.lo[a]) * res[a]), 0, res[a] - 1);
+    index = index * size_t(res[a]) + size_t(c);
+  }
+  return !emitting_cells_[index];
+}
+
 size_t MfsIntegrator::memory_bytes() const {
-  size_t bytes = (grid_ ? grid_->memory_bytes() : 0) + (beam_ ? beam_->memory_bytes() : 0);
+  size_t bytes =
+      (grid_ ? grid_->memory_bytes() : 0) + (beam_ ? beam_->memory_bytes() : 0) + emitting_cells_.size();
   for (const auto& m : full_maps_) bytes += m.memory_bytes();
   for (const auto& m : reduced_maps_) bytes += m.memory_bytes();
   return bytes;
@@ -161,14 +198,16 @@ Rgb MfsIntegrator::trace(const Ray& ray, Rng& rng, CameraSample* sample, int bou
   Rgb L(0.0);
   CameraPath cam;  // from the camera to the current step: T_full, T_red, tau_p, theta_p, tau_red, m0..m2
   const double jitter = rng.uniform();
-  MediumPoint mp, mp_blur;
+  MediumPoint mp;
   const bool blur = s_.source_blur && !s_.light_side();  // forward_side "light" has no camera-side spread
   MarchRecorder layers(sample);  // direct: the lights' light that took at most one wide scatter
   Rgb direct(0.0);
   march_growing(
       ctx_.majorants, o, d, hit.t, s_.tau_step, jitter,
-      // Steps grow with the camera-side reduced depth: tau_step (1 + step_growth tau_red) (eq. D13).
-      [&] { return 1.0 + s_.step_growth * max_component(cam.tau_red); },
+      // Steps of tau_step (1 + step_growth tau_red), fixed where a medium may emit (eq. D13).
+      [&](double t0, double t1) {
+        return grows(o + d * (0.5 * (t0 + t1))) ? 1.0 + s_.step_growth * max_component(cam.tau_red) : 1.0;
+      },
       [&](const Vec3& p, double t, double dt) {
         ++mfs_march_steps;
         // Split the extinction at p into peak and reduced parts (eq. D2).
@@ -180,13 +219,7 @@ Rgb MfsIntegrator::trace(const Ray& ray, Rng& rng, CameraSample* sample, int bou
           const CameraPoint y = cam.at(k, jitter, dt, s_.light_side(), s_.path_lengthening);
           Sources src;  // via y.T_cam / y.T_full
           add_sources(mp, p, d, t, y, cam, rng, !blur, true, &src);
-          if (blur) {
-            // T_cam's light left its last scatter in the lateral footprint of depth t (eq. D14): the source
-            // there, zero outside the media. The forward peak alone (T_full) goes straight: read at p.
-            const Vec3 ps = p + lateral_offset(d, cam.lateral_spread(t), rng.uniform(), rng.uniform());
-            ctx_.media.eval(ps, &mp_blur);
-            add_sources(mp_blur, ps, d, t, y, cam, rng, true, false, &src);
-          }
+          if (blur) add_blurred_sources(p, d, t, y, cam, rng, &src);
           L_step = (y.T_cam * src.in_scatter + y.T_full * src.peak_scatter) * dt;
           L += L_step;
           direct += (y.T_cam * src.lights_scatter + y.T_full * src.peak_scatter) * dt;
@@ -215,6 +248,17 @@ Rgb MfsIntegrator::trace(const Ray& ray, Rng& rng, CameraSample* sample, int bou
   return L + L_end;
 }
 
+void MfsIntegrator::add_blurred_sources(const Vec3& p, const Vec3& d, double t, const CameraPoint& y,
+                                        const CameraPath& cam, Rng& rng, Sources* out) const {
+  // T_cam's light left its last scatter in the lateral footprint of depth t (eq. D14): the source there,
+  // zero outside the media.
+  const double u1 = rng.uniform(), u2 = rng.uniform();  // in this order (argument order is unspecified)
+  const Vec3 ps = p + lateral_offset(d, cam.lateral_spread(t), u1, u2);
+  MediumPoint m;
+  ctx_.media.eval(ps, &m);
+  add_sources(m, ps, d, t, y, cam, rng, true, false, out);
+}
+
 void MfsIntegrator::add_sources(const MediumPoint& m, const Vec3& p, const Vec3& d, double t,
                                 const CameraPoint& y, const CameraPath& cam, Rng& rng, bool scattered,
                                 bool peak, Sources* out) const {
@@ -240,13 +284,14 @@ MfsIntegrator::MediumRadiance MfsIntegrator::medium_radiance(int i, const Vec3& 
       out.L += light_side_scatter(ls.weight, f, split, mu, beam.tau_ps, beam.T_wide);  // eq. D11
       return;
     }
-    if (s_.large_angle_scatters != 0)  // eq. D7, first term
-      out.L += first_wide_scatter(ls.weight, f, split, mu, y.tau_p, s_.light_blur ? beam.tau_ps : Rgb(0.0),
+    const PhaseSplit::Angle a = PhaseSplit::angle(mu);  // once for both terms
+    if (s_.large_angle_scatters != 0)                   // eq. D7, first term
+      out.L += first_wide_scatter(ls.weight, f, split, a, y.tau_p, s_.light_blur ? beam.tau_ps : Rgb(0.0),
                                   beam.T_wide);
     if (s_.forward_light_path())  // eq. D7, second term: to the camera with T_full
-      out.L_peak += forward_peak(ls.weight, f, split, mu, beam.tau_ps, beam.T_wide);
+      out.L_peak += forward_peak(ls.weight, f, split, a, beam.tau_ps, beam.T_wide);
     else  // eq. D7b (beer_lambert)
-      out.L += forward_peak(ls.weight, f, split, mu, y.tau_p, beam.T_light);
+      out.L += forward_peak(ls.weight, f, split, a, y.tau_p, beam.T_light);
   };
   // Sample every light once (u1, u2, in this order).
   for (size_t l = 0; l < ctx_.lights.size(); ++l) {

@@ -30,7 +30,7 @@
 // | field                     | type                          | default   | meaning                               |
 // |---------------------------|-------------------------------|-----------|---------------------------------------|
 // | `tau_step`                | number in [1e-4, 100]         | 0.1       | optical depth per march step (against the majorant) |
-// | `step_growth`             | number in [0, 100]            | 1         | steps of tau_step (1 + step_growth tau_red), tau_red the camera-side reduced depth |
+// | `step_growth`             | number in [0, 100]            | 3         | steps of tau_step (1 + step_growth tau_red), tau_red the camera-side reduced depth; fixed steps in the majorant cells where a medium may emit |
 // | `light_path`              | "forward" or "beer_lambert"   | "forward" | the light reaches the first wide scatter through peak scatters (reduced extinction), or unscattered only (the seed paper) |
 // | `propagator`              | "gsa" or "gaussian"           | "gsa"     | the peak's own moments in the small-angle propagator, or a Gaussian stand-in with the same theta2 |
 // | `peak_fraction`           | "auto" or [0, 0.99]           | "auto"    | f, the part of each phase function carried as a forward peak ("auto": g^2 per medium) |
@@ -72,7 +72,7 @@ enum class ForwardSide { camera, light };
 
 struct MfsSettings {
   double tau_step = 0.1;
-  double step_growth = 1.0;
+  double step_growth = 3.0;
   LightPath light_path = LightPath::forward;
   Propagator propagator = Propagator::gsa;
   std::optional<double> peak_fraction;      // nullopt: "auto"
@@ -126,6 +126,10 @@ class MfsIntegrator final : public Integrator {
   std::vector<TransmittanceGrid> full_maps_, reduced_maps_;  // per light
   std::unique_ptr<ScatterGrid> grid_;                        // wide scatters 2 .. K (null for K = 1)
   std::unique_ptr<BeamGrid> beam_;                           // the peak-only beams' correction (or null)
+  std::vector<uint8_t> emitting_cells_;  // per majorant cell: a medium may emit there (empty: none does)
+
+  // Whether the march's steps may grow in the majorant cell at p (no medium emits there; eq. D13).
+  bool grows(const Vec3& p) const;
 
   // The parts of `Li` (mfs.cpp); the physics is in mfs_estimators.h.
   struct MediumRadiance {
@@ -140,6 +144,10 @@ class MfsIntegrator final : public Integrator {
   };
   void add_sources(const MediumPoint& m, const Vec3& p, const Vec3& d, double t, const CameraPoint& y,
                    const CameraPath& cam, Rng& rng, bool scattered, bool peak, Sources* out) const;
+  // source_blur (eq. D14): T_cam's light read at a point of the lateral footprint around p, zero outside
+  // the media (the forward peak alone stays on the ray: add_sources at p).
+  void add_blurred_sources(const Vec3& p, const Vec3& d, double t, const CameraPoint& y,
+                           const CameraPath& cam, Rng& rng, Sources* out) const;
   // What medium i sends towards the camera from the sample point p (at distance t) of the march: one
   // sample of every light (eqs. D7, D11) and the scatter grid's higher orders (eq. D12).
   MediumRadiance medium_radiance(int i, const Vec3& p, const Vec3& d, double t, const CameraPoint& y,

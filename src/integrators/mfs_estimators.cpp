@@ -108,21 +108,29 @@ LightBeam peak_only_beam(const Rgb& T_light, const Rgb& T_wide, bool traced, con
   return b;
 }
 
-Rgb first_wide_scatter(const Rgb& E, double f, const PhaseSplit& split, double mu, const Rgb& tau_p,
-                       const Rgb& tau_ps, const Rgb& T_wide) {
+Rgb first_wide_scatter(const Rgb& E, double f, const PhaseSplit& split, const PhaseSplit::Angle& a,
+                       const Rgb& tau_p, const Rgb& tau_ps, const Rgb& T_wide) {
   // eq. D7, first term: light- and camera-side peak depths add (eq. D4).
   Rgb L;
-  const PhaseSplit::Angle a = PhaseSplit::angle(mu);
   for (int c = 0; c < 3; ++c) L[c] = E[c] * (1.0 - f) * split.wide_eff(tau_p[c] + tau_ps[c], a) * T_wide[c];
   return L;
 }
 
-Rgb forward_peak(const Rgb& E, double f, const PhaseSplit& split, double mu, const Rgb& tau, const Rgb& T) {
+Rgb first_wide_scatter(const Rgb& E, double f, const PhaseSplit& split, double mu, const Rgb& tau_p,
+                       const Rgb& tau_ps, const Rgb& T_wide) {
+  return first_wide_scatter(E, f, split, PhaseSplit::angle(mu), tau_p, tau_ps, T_wide);
+}
+
+Rgb forward_peak(const Rgb& E, double f, const PhaseSplit& split, const PhaseSplit::Angle& a, const Rgb& tau,
+                 const Rgb& T) {
   // eq. D7, second term (or D7b for beer_lambert).
   Rgb L;
-  const PhaseSplit::Angle a = PhaseSplit::angle(mu);
   for (int c = 0; c < 3; ++c) L[c] = E[c] * f * split.peak_eff(tau[c], a) * T[c];
   return L;
+}
+
+Rgb forward_peak(const Rgb& E, double f, const PhaseSplit& split, double mu, const Rgb& tau, const Rgb& T) {
+  return forward_peak(E, f, split, PhaseSplit::angle(mu), tau, T);
 }
 
 Rgb light_side_scatter(const Rgb& E, double f, const PhaseSplit& split, double mu, const Rgb& tau_ps,

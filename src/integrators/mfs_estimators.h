@@ -87,6 +87,11 @@ Rgb first_wide_scatter(const Rgb& E, double f, const PhaseSplit& split, double m
 // the last peak scatter of a path with no wide scatter; beer_lambert (eq. D7b): (tau_p, T_light), the
 // first peak scatter of unscattered light.
 Rgb forward_peak(const Rgb& E, double f, const PhaseSplit& split, double mu, const Rgb& tau, const Rgb& T);
+// The same two at the tables' angle node a = PhaseSplit::angle(mu), found once for both.
+Rgb first_wide_scatter(const Rgb& E, double f, const PhaseSplit& split, const PhaseSplit::Angle& a,
+                       const Rgb& tau_p, const Rgb& tau_ps, const Rgb& T_wide);
+Rgb forward_peak(const Rgb& E, double f, const PhaseSplit& split, const PhaseSplit::Angle& a, const Rgb& tau,
+                 const Rgb& T);
 // forward_side "light" (eq. D11): every scatter at y, whole phase function spread by the light side only:
 // E T_wide [(1 - f) wide_eff(tau_ps, mu) + f peak_eff(tau_ps, mu)].
 Rgb light_side_scatter(const Rgb& E, double f, const PhaseSplit& split, double mu, const Rgb& tau_ps,

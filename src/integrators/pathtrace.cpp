@@ -227,7 +227,8 @@ Rgb PathTracer::Li(const Ray& ray, Rng& rng, CameraSample* sample) const {
       const bool goes_on = reflect(hit, L, beta, wide, rng, clock);
       if (events == 0) first.direct = L - L_before;
       if (!goes_on || (max_events_ > 0 && events + 1 >= max_events_)) break;
-      d = cosine_direction(hit.ns, rng.uniform(), rng.uniform());
+      const double v2 = rng.uniform(), v1 = rng.uniform();  // the order GCC gave the arguments before
+      d = cosine_direction(hit.ns, v1, v2);
       if (dot(d, hit.ng) <= 0.0) break;  // below the geometric surface (shading normals): absorbed
       o = SceneSurfaces::offset(hit, d);
     } else if (escaped) {

@@ -446,6 +446,26 @@ TEST(Mfs, GrowingStepsMatchFixedSteps) {
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(a[c], b[c], 0.01 * b[c]) << c;
 }
 
+// Where a medium may emit, the steps do not grow (eq. D13): an emitting sphere renders bit for bit as with
+// fixed steps, while the same sphere without emission does not (its steps grow).
+TEST(Mfs, EmittingCellsMarchAtFixedSteps) {
+  for (const char* emission : {R"(, "emission": 0.5)", ""}) {
+    Scene scene = test::scene_from_json("{" + test::camera_json(16, 16, 40.0) + R"(,
+      "media": [{"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1}, "sigma_s": 10.0,
+                 "sigma_a": 0.5, "phase": {"type": "hg", "g": 0.85})" +
+                                        std::string(emission) + R"(}],
+      "lights": [{"type": "directional", "direction": [-1, 0.3, 0.2], "irradiance": 1.0}]})");
+    scene.integrator.type = "mfs";
+    scene.integrator.spp = 2;
+    scene.integrator.options = {{"step_growth", 3.0}};
+    const Image grown = render(scene, RenderOptions{}).image;
+    scene.integrator.options = {{"step_growth", 0.0}};
+    const Image fixed = render(scene, RenderOptions{}).image;
+    ASSERT_GT(image_mean(fixed)[0], 0.0);
+    EXPECT_EQ(grown.rgb == fixed.rgb, *emission != '\0') << emission;
+  }
+}
+
 // The scatter grid's pre-filtered (mip-mapped) lookups: a zero spread is the plain lookup, and the
 // image with the filtered lookups deeper in differs from the plain one by a few per cent at most (the
 // filter moves light within the medium, it does not make or lose much).
