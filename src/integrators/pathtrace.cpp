@@ -13,6 +13,13 @@ namespace nimbus {
 
 namespace {
 
+// A cosine-distributed direction about n; the second number drawn first (the order GCC gave the
+// arguments of cosine_direction(n, rng.uniform(), rng.uniform()) before: fixed now for every compiler).
+Vec3 diffuse_bounce(const Vec3& n, Rng& rng) {
+  const double v2 = rng.uniform(), v1 = rng.uniform();
+  return cosine_direction(n, v1, v2);
+}
+
 // The depth march's step in optical depth against the majorant (deterministic: no random numbers).
 constexpr double kDepthTauStep = 0.02;
 
@@ -227,8 +234,7 @@ Rgb PathTracer::Li(const Ray& ray, Rng& rng, CameraSample* sample) const {
       const bool goes_on = reflect(hit, L, beta, wide, rng, clock);
       if (events == 0) first.direct = L - L_before;
       if (!goes_on || (max_events_ > 0 && events + 1 >= max_events_)) break;
-      const double v2 = rng.uniform(), v1 = rng.uniform();  // the order GCC gave the arguments before
-      d = cosine_direction(hit.ns, v1, v2);
+      d = diffuse_bounce(hit.ns, rng);
       if (dot(d, hit.ng) <= 0.0) break;  // below the geometric surface (shading normals): absorbed
       o = SceneSurfaces::offset(hit, d);
     } else if (escaped) {
