@@ -1,7 +1,6 @@
 #include "integrators/mfs.h"
 
 #include <fmt/format.h>
-#include <tbb/parallel_for.h>
 
 #include "core/json_reader.h"
 #include "integrators/area_light_view.h"
@@ -19,26 +18,6 @@ const std::vector<std::string> kLightPathNames = {"forward", "beer_lambert"};
 const std::vector<std::string> kPropagatorNames = {"gsa", "gaussian"};
 const std::vector<std::string> kPhotonTransportNames = {"exact", "similarity"};
 const std::vector<std::string> kForwardSideNames = {"camera", "light"};
-
-// Per majorant cell (the grid's order): whether a medium may emit there (SceneMedia::may_emit).
-std::vector<uint8_t> emitting_cells(const SceneContext& ctx) {
-  const auto res = ctx.majorants.resolution();
-  const Bounds b = ctx.majorants.bounds();
-  const Vec3 cell = Vec3((b.hi.x - b.lo.x) / res[0], (b.hi.y - b.lo.y) / res[1], (b.hi.z - b.lo.z) / res[2]);
-  std::vector<uint8_t> emits(size_t(res[0]) * res[1] * res[2], 0);
-  tbb::parallel_for(0, res[2], [&](int z) {
-    for (int y = 0; y < res[1]; ++y)
-      for (int x = 0; x < res[0]; ++x) {
-        Bounds box;
-        box.lo = b.lo + Vec3(x, y, z) * cell;
-        box.hi = box.lo + cell;
-        bool e = false;
-        for (int i = 0; i < ctx.media.count() && !e; ++i) e = ctx.media.may_emit(i, box);
-        emits[(size_t(z) * res[1] + y) * res[0] + x] = e;
-      }
-  });
-  return emits;
-}
 }  // namespace
 
 MfsSettings mfs_settings_from_json(const nlohmann::json& options, const std::string& where) {
@@ -137,9 +116,6 @@ MfsIntegrator::MfsIntegrator(const SceneContext& context, MfsSettings settings, 
     s_.scatter_grid_resolution =
         std::isfinite(across) ? int(std::clamp(std::ceil(across / 1.6), 32.0, 64.0)) : 64;
   }
-  // The majorant cells where a medium may emit march at fixed steps (eq. D13): the growing steps sample
-  // the emission's spatial variation, which no blur smooths, too coarsely.
-  if (ctx_.media.emits() && s_.step_growth > 0.0) emitting_cells_ = emitting_cells(ctx_);
   std::vector<const PhaseSplit*> splits;  // for the photon grids
   for (const auto& sp : splits_) splits.push_back(sp.get());
   if (s_.forward_light_path() && s_.beam_photons > 0 && !ctx_.lights.empty()) {
@@ -160,21 +136,8 @@ MfsIntegrator::MfsIntegrator(const SceneContext& context, MfsSettings settings, 
   }
 }
 
-bool MfsIntegrator::grows(const Vec3& p) const {
-  if (emitting_cells_.empty()) return true;
-  const auto res = ctx_.majorants.resolution();
-  const Bounds& b = ctx_.majorants.bounds();
-  size_t index = 0;
-  for (int a = 2; a >= 0; --a) {
-    const int c = std::clamp(int((p[a] - b.lo[a]) / (b.hi[a] - b.lo[a]) * res[a]), 0, res[a] - 1);
-    index = index * size_t(res[a]) + size_t(c);
-  }
-  return !emitting_cells_[index];
-}
-
 size_t MfsIntegrator::memory_bytes() const {
-  size_t bytes =
-      (grid_ ? grid_->memory_bytes() : 0) + (beam_ ? beam_->memory_bytes() : 0) + emitting_cells_.size();
+  size_t bytes = (grid_ ? grid_->memory_bytes() : 0) + (beam_ ? beam_->memory_bytes() : 0);
   for (const auto& m : full_maps_) bytes += m.memory_bytes();
   for (const auto& m : reduced_maps_) bytes += m.memory_bytes();
   return bytes;
@@ -204,9 +167,11 @@ Rgb MfsIntegrator::trace(const Ray& ray, Rng& rng, CameraSample* sample, int bou
   Rgb direct(0.0);
   march_growing(
       ctx_.majorants, o, d, hit.t, s_.tau_step, jitter,
-      // Steps of tau_step (1 + step_growth tau_red), fixed where a medium may emit (eq. D13).
+      // Steps of tau_step (1 + step_growth tau_red), fixed in the cells where a medium may emit (eq. D13):
+      // growing steps would sample the emission's spatial variation, which no blur smooths, too coarsely.
       [&](double t0, double t1) {
-        return grows(o + d * (0.5 * (t0 + t1))) ? 1.0 + s_.step_growth * max_component(cam.tau_red) : 1.0;
+        const bool emits = ctx_.majorants.may_emit_at(o + d * (0.5 * (t0 + t1)));
+        return emits ? 1.0 : 1.0 + s_.step_growth * max_component(cam.tau_red);
       },
       [&](const Vec3& p, double t, double dt) {
         ++mfs_march_steps;

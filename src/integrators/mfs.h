@@ -126,10 +126,6 @@ class MfsIntegrator final : public Integrator {
   std::vector<TransmittanceGrid> full_maps_, reduced_maps_;  // per light
   std::unique_ptr<ScatterGrid> grid_;                        // wide scatters 2 .. K (null for K = 1)
   std::unique_ptr<BeamGrid> beam_;                           // the peak-only beams' correction (or null)
-  std::vector<uint8_t> emitting_cells_;  // per majorant cell: a medium may emit there (empty: none does)
-
-  // Whether the march's steps may grow in the majorant cell at p (no medium emits there; eq. D13).
-  bool grows(const Vec3& p) const;
 
   // The parts of `Li` (mfs.cpp); the physics is in mfs_estimators.h.
   struct MediumRadiance {

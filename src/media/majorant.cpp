@@ -66,6 +66,7 @@ MajorantGrid::MajorantGrid(const SceneMedia& media, int resolution, bool global)
   }
   for (int a = 0; a < 3; ++a) cell_size_[a] = extent[a] / res_[a];
   maj_.assign(size_t(res_[0]) * res_[1] * res_[2], 0.0f);
+  if (media.emits()) emits_.assign(maj_.size(), 0);
   const double min_cell = std::min({cell_size_.x, cell_size_.y, cell_size_.z});
   tbb::parallel_for(0, res_[2], [&](int z) {
     for (int y = 0; y < res_[1]; ++y) {
@@ -81,13 +82,26 @@ MajorantGrid::MajorantGrid(const SceneMedia& media, int resolution, bool global)
         }
         // Emitting cells get at least kEmissionCollisionsPerCell tentative collisions per cell width, so
         // that thin or transparent emitters are sampled (media/emission.h).
+        const size_t index = (size_t(z) * res_[1] + y) * res_[0] + x;
         for (int i = 0; i < media.count() && media.emits(); ++i)
-          if (media.may_emit(i, cell)) m = std::max(m, kEmissionCollisionsPerCell / min_cell);
+          if (media.may_emit(i, cell)) {
+            m = std::max(m, kEmissionCollisionsPerCell / min_cell);
+            emits_[index] = 1;
+          }
         // Round up so the float never falls below the double bound.
-        maj_[(size_t(z) * res_[1] + y) * res_[0] + x] = m > 0.0 ? std::nextafter(float(m), INFINITY) : 0.0f;
+        maj_[index] = m > 0.0 ? std::nextafter(float(m), INFINITY) : 0.0f;
       }
     }
   });
+}
+
+bool MajorantGrid::may_emit_at(const Vec3& p) const {
+  if (emits_.empty()) return false;
+  size_t index = 0;
+  for (int a = 2; a >= 0; --a)  // the cell as traverse finds it
+    index = index * size_t(res_[a]) +
+            size_t(std::clamp(int((p[a] - bounds_.lo[a]) / cell_size_[a]), 0, res_[a] - 1));
+  return emits_[index] != 0;
 }
 
 }  // namespace nimbus

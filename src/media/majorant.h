@@ -5,6 +5,7 @@
 #pragma once
 
 #include <array>
+#include <cstdint>
 #include <vector>
 
 #include "core/math.h"
@@ -26,7 +27,9 @@ class MajorantGrid {
   const Bounds& bounds() const { return bounds_; }
   std::array<int, 3> resolution() const { return res_; }
   double cell_majorant(int x, int y, int z) const { return maj_[(size_t(z) * res_[1] + y) * res_[0] + x]; }
-  size_t memory_bytes() const { return maj_.size() * sizeof(float); }
+  // Whether a medium may emit in the cell that holds p (clamped to the grid; SceneMedia::may_emit).
+  bool may_emit_at(const Vec3& p) const;
+  size_t memory_bytes() const { return maj_.size() * sizeof(float) + emits_.size(); }
 
   // Visits the cells a ray crosses within [tmin, tmax] in order, calling
   // segment(t0, t1, majorant) -> bool (false stops). d need not be normalised; t is in units of d.
@@ -38,6 +41,7 @@ class MajorantGrid {
   std::array<int, 3> res_{1, 1, 1};
   Vec3 cell_size_{1.0};
   std::vector<float> maj_;
+  std::vector<uint8_t> emits_;  // per cell: a medium may emit there (empty when no medium emits)
 };
 
 template <typename F>
