@@ -18,6 +18,7 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <utility>
 
 #include "integrators/registry.h"
 #include "nimbus/error.h"
@@ -105,6 +106,22 @@ struct PixelTargets {
   TimeFilm* time_film = nullptr;  // a transient render (film.time_bins)
 };
 
+// Positions in pixel (x, y): the R2 sequence rotated by the pixel's own random offset, drawn from the
+// random stream `stream` of the pixel (render_pixel's comment says why).
+struct PixelSequence {
+  double ux, uy;
+  PixelSequence(uint64_t seed, int x, int y, uint64_t stream) {
+    Rng shift = Rng::for_sample(seed, uint32_t(x), uint32_t(y), stream);
+    ux = shift.uniform();
+    uy = shift.uniform();
+  }
+  // Sample s's position in the pixel, in [0, 1)^2.
+  std::pair<double, double> at(int s) const {
+    double jx = ux + s * kR2a1, jy = uy + s * kR2a2;
+    return {jx - std::floor(jx), jy - std::floor(jy)};
+  }
+};
+
 // Samples of pixel (x, y) into the film. Positions in the pixel: the R2 sequence (Roberts 2018), shifted
 // by a random offset per pixel (a Cranley-Patterson rotation, so each sample is still uniform over the
 // pixel and the estimate unbiased); its samples are spread evenly for every spp, which halves edge noise
@@ -113,8 +130,7 @@ struct PixelTargets {
 int64_t render_pixel(const Integrator& integrator, const PinholeCamera& camera,
                      const IntegratorSettings& settings, int x, int y, int s0, int s1,
                      const PixelTargets& to) {
-  Rng shift = Rng::for_sample(settings.seed, uint32_t(x), uint32_t(y), ~uint64_t(0));
-  const double ux = shift.uniform(), uy = shift.uniform();
+  const PixelSequence positions(settings.seed, x, y, ~uint64_t(0));
   int64_t bad = 0;
   thread_local std::vector<DeepSegment> segments, sample_segments;
   thread_local std::vector<TimedContribution> timed;
@@ -123,9 +139,7 @@ int64_t render_pixel(const Integrator& integrator, const PinholeCamera& camera,
   s1 += to.sample_start;
   for (int s = s0; s < s1; ++s) {
     Rng rng = Rng::for_sample(settings.seed, uint32_t(x), uint32_t(y), uint64_t(s));
-    double jx = ux + s * kR2a1, jy = uy + s * kR2a2;
-    jx -= std::floor(jx);
-    jy -= std::floor(jy);
+    const auto [jx, jy] = positions.at(s);
     CameraSample sample;
     sample.depth_wanted = to.layers.depth_wanted();
     sample_segments.clear();
@@ -152,13 +166,10 @@ int64_t render_pixel(const Integrator& integrator, const PinholeCamera& camera,
 // in the pixel rotated by an offset of their own), so that nothing the image takes decides its counts.
 void render_probes(const Integrator& integrator, const PinholeCamera& camera,
                    const IntegratorSettings& settings, int x, int y, int s0, int s1, const PixelTargets& to) {
-  Rng shift = Rng::for_sample(settings.seed, uint32_t(x), uint32_t(y), kProbeIndexBase - 1);
-  const double ux = shift.uniform(), uy = shift.uniform();
+  const PixelSequence positions(settings.seed, x, y, kProbeIndexBase - 1);
   for (int s = s0; s < s1; ++s) {
     Rng rng = Rng::for_sample(settings.seed, uint32_t(x), uint32_t(y), kProbeIndexBase + uint64_t(s));
-    double jx = ux + s * kR2a1, jy = uy + s * kR2a2;
-    jx -= std::floor(jx);
-    jy -= std::floor(jy);
+    const auto [jx, jy] = positions.at(s);
     CameraSample sample;
     sample.depth_wanted = to.layers.depth_wanted();
     const uint64_t rng_start = rng.state();
