@@ -207,9 +207,11 @@ def measure(tag, scene, base, ref, label, block, spp, extra=(), seed=1):
 
 
 def frontier(tag, scene, base, ref_spp, mfs_spp=MFS_SPP, octave_spp=OCTAVE_SPP, pt_spp=PT_SPP, pt_noise=PT_NOISE,
-             images=None):
+             images=None, judge=None):
     """One scene's error-vs-time frontier: mfs and octave at a few spp, pathtrace uniform and adaptive, all
-    against one converged reference, back to back; equal-error times and speed-ups from the fitted curves."""
+    against one converged reference, back to back; equal-error times and speed-ups from the fitted curves.
+    judge: an earlier result of this scene whose pathtrace, adaptive and octave points are kept (only mfs
+    is rendered again)."""
     ref, noise = reference(tag, scene, base, ref_spp)
     exposure = math.log2(0.3 / max(compare(ref, ref)[2], 1e-12))
     if images:
@@ -222,6 +224,11 @@ def frontier(tag, scene, base, ref_spp, mfs_spp=MFS_SPP, octave_spp=OCTAVE_SPP, 
         if images and spp == 4:
             png(out, os.path.join(IMG, f"{images}_mfs.png"), exposure)
             png(out, os.path.join(IMG, f"{images}_mfs_error.png"), 0, heat_ref=ref)
+    if judge:
+        # The judge and octave as measured before (--mfs-only: only mfs changed since).
+        for key in ("pathtrace", "adaptive", "octave"):
+            r[key] = judge[key]
+        return fit_frontier(r, noise)
     for spp in pt_spp:
         r["pathtrace"].append(measure(tag, scene, base, ref, f"pt{spp}", {"type": "pathtrace"}, spp, seed=3)[0])
     for e in pt_noise:
@@ -232,6 +239,12 @@ def frontier(tag, scene, base, ref_spp, mfs_spp=MFS_SPP, octave_spp=OCTAVE_SPP, 
         r["octave"].append(row)
         if images and spp == 4:
             png(out, os.path.join(IMG, f"{images}_octave.png"), exposure)
+    return fit_frontier(r, noise)
+
+
+def fit_frontier(r, noise):
+    """The judge's fitted curves, each mfs and octave point's equal-error times and speed-ups, and mfs's
+    fixed cost."""
     c2, fits = uniform_fit(r["pathtrace"], noise)
     adaptive = adaptive_fit(r["adaptive"], noise, {key: fits[key][1] for key in fits})
     r["fit"] = {"c2": c2, "k_cpu_s": fits["cpu_s"][0], "t0_cpu_s": fits["cpu_s"][1], "k_s": fits["time_s"][0],
@@ -273,6 +286,8 @@ def main():
     ap.add_argument("--res", type=int, default=128, help="image size of the suite (res x res)")
     ap.add_argument("--results", help="results file (default docs/validation/render_results.json)")
     ap.add_argument("--mfs-spp", default=",".join(map(str, MFS_SPP)), help="the mfs frontier's spp, e.g. 1,4,16")
+    ap.add_argument("--mfs-only", action="store_true",
+                    help="render only mfs again; keep the judge's and octave's points (and reference) of the results")
     ap.add_argument("--ref-spp", type=json.loads, help='reference spp per scene, JSON: {"disney_cloud": 256}')
     args = ap.parse_args()
     os.makedirs(TMP, exist_ok=True)
@@ -297,8 +312,14 @@ def main():
         tag = f"{name}_{args.res}x{args.res}"
         ref_spp = REF_SPP_128.get(name, 4096)
         ref_spp = int(args.ref_spp.get(name, ref_spp)) if args.ref_spp else ref_spp
-        r = frontier(tag, sc, base, ref_spp, mfs_spp=[int(x) for x in args.mfs_spp.split(",")], images=name)
-        r["commit"], r["machine"] = commit_id(), machine_state()
+        judge = results.get(name) if args.mfs_only else None
+        if args.mfs_only and not judge:
+            sys.exit(f"--mfs-only: {name} has no earlier result in {results_path}")
+        r = frontier(tag, sc, base, ref_spp, mfs_spp=[int(x) for x in args.mfs_spp.split(",")], images=name,
+                     judge=judge)
+        r["mfs_commit"], r["mfs_machine"] = commit_id(), machine_state()
+        r["commit"], r["machine"] = (judge["commit"], judge["machine"]) if judge else (r["mfs_commit"],
+                                                                                       r["mfs_machine"])
         results[name] = r
         json.dump(results, open(results_path, "w"), indent=1, sort_keys=True)
     write_table(results)
@@ -507,12 +528,14 @@ def write_table(results):
     if not res:
         return
     r0 = res[names[0]]
-    loads = [r["machine"]["load_average"][0] for r in res.values()]
-    commits = sorted({r["commit"] for r in res.values()})
-    dates = sorted(r["machine"]["date"] for r in res.values())
-    head = [f"{r0['width']} x {r0['height']}, commits {', '.join(commits)} (these differ in validation/ only: the "
-            f"renderer is main's 220836a), {dates[0]} to {dates[-1][11:]}; load average {min(loads):.1f} to "
-            f"{max(loads):.1f} on {r0['machine']['cpus']} cores while measured.", ""]
+    machines = [r[k] for r in res.values() for k in ("machine", "mfs_machine") if k in r]
+    loads = [m["load_average"][0] for m in machines]
+    dates = sorted(m["date"] for m in machines)
+    per_scene = "; ".join(f"{n}: {r['commit']}" + (f" (mfs {r['mfs_commit']})" if r.get("mfs_commit", r["commit"])
+                                                   != r["commit"] else "") for n, r in res.items())
+    head = [f"{r0['width']} x {r0['height']}, {dates[0]} to {dates[-1]}; load average {min(loads):.1f} to "
+            f"{max(loads):.1f} on {r0['machine']['cpus']} cores while measured. Commits (the judge's and "
+            f"octave's points; mfs's where it was measured again with --mfs-only): {per_scene}.", ""]
     text = "\n".join(head + speed_rows(res) + ["", "The frontiers (rel RMSE @ CPU seconds):", ""] +
                      frontier_rows(res))
     print(text)
