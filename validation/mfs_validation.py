@@ -315,6 +315,8 @@ def main():
         judge = results.get(name) if args.mfs_only else None
         if args.mfs_only and not judge:
             sys.exit(f"--mfs-only: {name} has no earlier result in {results_path}")
+        if judge:
+            ref_spp = judge["reference_spp"]  # the judge's points were measured against this reference
         r = frontier(tag, sc, base, ref_spp, mfs_spp=[int(x) for x in args.mfs_spp.split(",")], images=name,
                      judge=judge)
         r["mfs_commit"], r["mfs_machine"] = commit_id(), machine_state()
