@@ -11,7 +11,9 @@
 namespace nimbus {
 namespace {
 
-constexpr int kFloats = 9;  // per node: traced (rgb), traced x mean cosine (rgb), straight (rgb)
+// Per node: traced (rgb), traced x mean cosine (rgb), straight (rgb), and with a camera (peak_toward)
+// traced x P_peak towards the camera (rgb).
+constexpr int kBaseFloats = 9, kCameraFloats = 12;
 constexpr double kR2a1 = 0.75487766624669276, kR2a2 = 0.56984029099805327;  // the R2 sequence
 constexpr double kRoulette = 0.05;
 // Deposit samples (and the loss's midpoint rule) at most this many node spacings apart: 0.5 (0.25
@@ -21,15 +23,18 @@ constexpr double kDepositStep = 0.5;  // roulette below this ratio of weight to 
 
 // Adds v (channel ch) with trilinear weights st to the tally: to the straight column, or to the traced
 // one and (times mu) the traced x cosine one.
-void splat(float* tally, const TrilinearStencil& st, int ch, double v, double mu, bool straight) {
+// stride: floats per node; pk: P_peak towards the camera (stride kCameraFloats only).
+void splat(float* tally, int stride, const TrilinearStencil& st, int ch, double v, double mu, double pk,
+           bool straight) {
   for (int j = 0; j < 8; ++j)
     if (st.weight[j] > 0.0) {
-      float* node = &tally[st.node[j] * kFloats];
+      float* node = &tally[st.node[j] * stride];
       if (straight) {
         node[6 + ch] += float(st.weight[j] * v);
       } else {
         node[ch] += float(st.weight[j] * v);
         node[3 + ch] += float(st.weight[j] * v * mu);
+        if (stride == kCameraFloats) node[9 + ch] += float(st.weight[j] * v * pk);
       }
     }
 }
@@ -59,6 +64,8 @@ struct BeamPhotons {
   Vec3 centre;  // of the node grid's bounding sphere, which the photons are aimed at
   double radius;
   double majorant_scale;  // the share of the majorant that bounds the peak-scatter rate
+  const Vec3* camera;     // tally P_peak (of medium 0) towards this point, or null
+  int stride;             // floats per node
 
   void trace(size_t j, Rng& rng, PhotonBatch& batch) const;
   Rgb deposit(float* tally, const Vec3& x, const Vec3& w, double t_end, Rgb weight, int c,
@@ -86,12 +93,14 @@ Rgb BeamPhotons::deposit(float* tally, const Vec3& x, const Vec3& w, double t_en
     const double geo = point ? 1.0 / std::max(1e-300, dot(q - point->position, q - point->position)) : 1.0;
     // The cosine between the travel direction and the straight one from the light.
     const double mu = straight ? 1.0 : point ? dot(w, normalize(q - point->position)) : dot(w, dir_w);
+    // The peak-only light's last peak scatter towards the camera (the forward-peak term's angular factor).
+    const double pk = camera && !straight ? splits[0]->peak(dot(w, normalize(*camera - q))) : 0.0;
     const TrilinearStencil st = grid.stencil(q);
     for (int ch = 0; ch < 3; ++ch) {
       if ((!grey && ch != c) || !(tw[ch] > 1e-30)) continue;
       const double v = mid[ch] * dl / (tw[ch] * geo);
       NIMBUS_DCHECK(v >= 0.0 && std::isfinite(v));
-      splat(tally, st, ch, v, mu, straight);
+      splat(tally, stride, st, ch, v, mu, pk, straight);
     }
   }
   return weight;
@@ -169,7 +178,9 @@ bool BeamPhotons::scatter(const Vec3& xc, Vec3* w, BeamWalk& walk, Rng& rng, Pho
 BeamGrid::BeamGrid(const SceneContext& ctx, const std::vector<const PhaseSplit*>& splits,
                    const std::vector<double>& peak_fraction,
                    const std::vector<TransmittanceGrid>& reduced_maps, int photons, int resolution,
-                   uint64_t seed) {
+                   uint64_t seed, const Vec3* camera)
+    : stride_(camera ? kCameraFloats : kBaseFloats) {
+  if (camera) camera_ = *camera;
   values_.resize(ctx.lights.size());
   const Bounds media_bounds = ctx.media.bounds();
   if (media_bounds.empty() || photons <= 0 || reduced_maps.size() != ctx.lights.size()) return;
@@ -200,29 +211,34 @@ BeamGrid::BeamGrid(const SceneContext& ctx, const std::vector<const PhaseSplit*>
                            .per_light = per_light,
                            .centre = centre,
                            .radius = radius,
-                           .majorant_scale = scale};
+                           .majorant_scale = scale,
+                           .camera = camera ? &camera_ : nullptr,
+                           .stride = stride_};
     // The batches' sums divided by the node volume.
     values_[l] = trace_photons(
-        total, seed ^ 0x7065616b6265616dull ^ (uint64_t(l) << 40), grid_.size() * kFloats,
+        total, seed ^ 0x7065616b6265616dull ^ (uint64_t(l) << 40), grid_.size() * size_t(stride_),
         1.0 / grid_.cell_volume(), [&](size_t j, Rng& rng, PhotonBatch& batch) { beam.trace(j, rng, batch); },
         &rejection_failures_);
   }
 }
 
-bool BeamGrid::lookup(size_t light, const Vec3& p, Rgb* factor, Rgb* mean_cosine) const {
+bool BeamGrid::lookup(size_t light, const Vec3& p, Rgb* factor, Rgb* mean_cosine, Rgb* peak_toward) const {
   if (light >= values_.size() || values_[light].empty() || !grid_.bounds.contains(p)) return false;
   const std::vector<float>& v = values_[light];
   const TrilinearStencil st = grid_.stencil(p);
-  Rgb r(0.0), m(0.0), straight(0.0);
+  Rgb r(0.0), m(0.0), straight(0.0), pk(0.0);
   for (int k = 0; k < 8; ++k)
     for (int c = 0; c < 3; ++c) {
-      r[c] += st.weight[k] * v[st.node[k] * kFloats + c];
-      m[c] += st.weight[k] * v[st.node[k] * kFloats + 3 + c];
-      straight[c] += st.weight[k] * v[st.node[k] * kFloats + 6 + c];
+      const float* node = &v[st.node[k] * size_t(stride_)];
+      r[c] += st.weight[k] * node[c];
+      m[c] += st.weight[k] * node[3 + c];
+      straight[c] += st.weight[k] * node[6 + c];
+      if (stride_ == kCameraFloats) pk[c] += st.weight[k] * node[9 + c];
     }
   for (int c = 0; c < 3; ++c) {
     (*factor)[c] = straight[c] > 0.0 ? r[c] / straight[c] : 1.0;
     (*mean_cosine)[c] = r[c] > 0.0 ? std::clamp(m[c] / r[c], -1.0, 1.0) : 1.0;
+    if (peak_toward) (*peak_toward)[c] = r[c] > 0.0 ? pk[c] / r[c] : 0.0;
   }
   return true;
 }

@@ -32,10 +32,13 @@ class BeamGrid {
   // reduced_maps[l]: light l's T_wide; photons: per light; resolution as ScatterGridSettings.
   BeamGrid(const SceneContext& ctx, const std::vector<const PhaseSplit*>& splits,
            const std::vector<double>& peak_fraction, const std::vector<TransmittanceGrid>& reduced_maps,
-           int photons, int resolution, uint64_t seed);
+           int photons, int resolution, uint64_t seed, const Vec3* camera = nullptr);
   // R for light `light` at p (trilinear between nodes) and the peak-only light's mean cosine to the
   // straight direction from the light; false (nothing written) outside the grid and for other lights.
-  bool lookup(size_t light, const Vec3& p, Rgb* factor, Rgb* mean_cosine) const;
+  // With a camera, peak_toward (if not null) gets the traced beam's P_peak (medium 0's) towards the camera,
+  // averaged over its directions: the angular factor of the forward peak alone (eq. D7's peak_eff).
+  bool lookup(size_t light, const Vec3& p, Rgb* factor, Rgb* mean_cosine, Rgb* peak_toward = nullptr) const;
+  bool has_camera() const { return stride_ > 9; }
   size_t memory_bytes() const;
   // Peak scatters whose direction the rejection sampler could not draw (the photon flew on
   // undeflected; see sample_by_rejection). 0 in every normal case.
@@ -45,6 +48,8 @@ class BeamGrid {
   NodeGrid grid_;                           // the media's bounds padded by one spacing (node_grid_padded)
   std::vector<std::vector<float>> values_;  // per light and node: traced, traced x cosine, straight (rgb)
   uint64_t rejection_failures_ = 0;
+  int stride_;        // floats per node
+  Vec3 camera_{0.0};  // the point P_peak is tallied towards (with stride_ 12)
 };
 
 }  // namespace nimbus

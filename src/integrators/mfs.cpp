@@ -42,6 +42,8 @@ MfsSettings mfs_settings_from_json(const nlohmann::json& options, const std::str
   s.path_lengthening = o.boolean("path_lengthening", s.path_lengthening);
   s.filtered_lookups = o.boolean("filtered_lookups", s.filtered_lookups);
   s.source_blur = o.boolean("source_blur", s.source_blur);
+  s.peak_toward_camera = o.boolean("peak_toward_camera", s.peak_toward_camera);
+  s.exact_light_transmittance = o.boolean("exact_light_transmittance", s.exact_light_transmittance);
   s.shadow_map_resolution = int(o.integer("shadow_map_resolution", 8, 1024, s.shadow_map_resolution));
   o.finish();
   // The light side carries the light to every scatter through peak scatters, with photons in the true
@@ -69,6 +71,8 @@ nlohmann::json to_json(const MfsSettings& s) {
                       {"path_lengthening", s.path_lengthening},
                       {"filtered_lookups", s.filtered_lookups},
                       {"source_blur", s.source_blur},
+                      {"peak_toward_camera", s.peak_toward_camera},
+                      {"exact_light_transmittance", s.exact_light_transmittance},
                       {"shadow_map_resolution", s.shadow_map_resolution}};
   j["peak_fraction"] = s.peak_fraction ? nlohmann::json(*s.peak_fraction) : nlohmann::json("auto");
   j["large_angle_scatters"] =
@@ -119,8 +123,11 @@ MfsIntegrator::MfsIntegrator(const SceneContext& context, MfsSettings settings, 
   std::vector<const PhaseSplit*> splits;  // for the photon grids
   for (const auto& sp : splits_) splits.push_back(sp.get());
   if (s_.forward_light_path() && s_.beam_photons > 0 && !ctx_.lights.empty()) {
+    // peak_toward_camera: the beam's P_peak towards the camera tallied too (one medium only).
+    const Vec3 camera = ctx_.camera.origin();
+    const bool toward = s_.peak_toward_camera && ctx_.media.count() == 1;
     beam_ = std::make_unique<BeamGrid>(ctx_, splits, f_, reduced_maps_, s_.beam_photons,
-                                       *s_.scatter_grid_resolution, seed);
+                                       *s_.scatter_grid_resolution, seed, toward ? &camera : nullptr);
   }
   // Wide scatters 2 .. K from the scatter grid (for K = 1 only the environment's light).
   if (s_.large_angle_scatters != 0 &&
@@ -242,6 +249,11 @@ MfsIntegrator::MediumRadiance MfsIntegrator::medium_radiance(int i, const Vec3& 
   const PhaseSplit& split = *splits_[i];
   const double f = f_[i];
   MediumRadiance out{Rgb(0.0), Rgb(0.0), Rgb(0.0)};
+  // peak_toward_camera's tally holds the light sent towards the camera: used on rays from it only.
+  const auto camera_ray = [&] {
+    const Vec3 v = p - ctx_.camera.origin(), c = cross(v, d);
+    return dot(v, d) > 0.0 && dot(c, c) <= 1e-12 * dot(v, v);
+  };
   // A light's first wide scatter and forward peak at p, from its sample ls and the beam towards it.
   auto add_light = [&](const LightSample& ls, const LightBeam& beam) {
     const double mu = dot(d, ls.wi);
@@ -253,7 +265,9 @@ MfsIntegrator::MediumRadiance MfsIntegrator::medium_radiance(int i, const Vec3& 
     if (s_.large_angle_scatters != 0)                   // eq. D7, first term
       out.L += first_wide_scatter(ls.weight, f, split, a, y.tau_p, s_.light_blur ? beam.tau_ps : Rgb(0.0),
                                   beam.T_wide);
-    if (s_.forward_light_path())  // eq. D7, second term: to the camera with T_full
+    if (s_.forward_light_path() && beam.toward && camera_ray())  // the traced beam's P_peak to the camera
+      out.L_peak += ls.weight * f * beam.peak_toward * beam.T_wide;
+    else if (s_.forward_light_path())  // eq. D7, second term: to the camera with T_full
       out.L_peak += forward_peak(ls.weight, f, split, a, beam.tau_ps, beam.T_wide);
     else  // eq. D7b (beer_lambert)
       out.L += forward_peak(ls.weight, f, split, a, y.tau_p, beam.T_light);
@@ -294,19 +308,48 @@ LightBeam MfsIntegrator::environment_beam(int i, const Vec3& p, const Vec3& wi) 
                         s_.forward_light_path() && s_.path_lengthening);
 }
 
+void MfsIntegrator::exact_light_transmittance(const Vec3& p, const LightSample& ls, Rgb* T_light,
+                                              Rgb* T_wide) const {
+  // One constant-density sphere or box: the chord to the light in closed form. The shadow maps'
+  // trilinear interpolation over-estimates T where the light grazes a sharp boundary (the chord grows
+  // like sqrt of the distance to the tangent point, T is convex there): a backlit sphere's rim.
+  double t0 = 0.0, t1 = 0.0;
+  if (ctx_.analytic.active() && ctx_.media.count() == 1) {
+    if (!ctx_.analytic.chord(0, p, ls.wi, ls.distance, &t0, &t1) || !(t1 > t0)) {
+      *T_light = *T_wide = Rgb(1.0);
+      return;
+    }
+    MediumPoint m;
+    ctx_.media.eval(p + ls.wi * (0.5 * (t0 + t1)), &m);
+    const Rgb sigma_t = m.sigma_t(), sigma_red = sigma_t - m.sigma_s_i[0] * f_[0];
+    *T_light = exp(-sigma_t * (t1 - t0));
+    *T_wide = exp(-sigma_red * (t1 - t0));
+    return;
+  }
+  marched_full_and_reduced(ctx_, p, ls.wi, ls.distance, kSurfaceShadowStep, f_, T_light, T_wide);
+}
+
 LightBeam MfsIntegrator::light_beam(size_t l, int i, const Vec3& p, const LightSample& ls) const {
   Rgb T_light, T_wide;
   if (is_area_light(ctx_.lights[l])) {  // an area light: march to its sampled point instead of a map
     marched_full_and_reduced(ctx_, p, ls.wi, ls.distance, kSurfaceShadowStep, f_, &T_light, &T_wide);
     if (!s_.forward_light_path()) T_wide = T_light;
+  } else if (s_.exact_light_transmittance) {
+    exact_light_transmittance(p, ls, &T_light, &T_wide);
+    if (!s_.forward_light_path()) T_wide = T_light;
   } else {
     T_light = full_maps_[l].lookup(p);
     T_wide = s_.forward_light_path() ? reduced_maps_[l].lookup(p) : T_light;
   }
-  Rgb R(1.0), mean_cos(1.0);
-  const bool traced = beam_ && beam_->lookup(l, p, &R, &mean_cos);
-  return peak_only_beam(T_light, T_wide, traced, R, mean_cos, splits_[i]->peak_moments(), theta2_[i],
-                        s_.forward_light_path() && s_.path_lengthening);
+  Rgb R(1.0), mean_cos(1.0), toward(0.0);
+  const bool traced = beam_ && beam_->lookup(l, p, &R, &mean_cos, &toward);
+  LightBeam b = peak_only_beam(T_light, T_wide, traced, R, mean_cos, splits_[i]->peak_moments(), theta2_[i],
+                               s_.forward_light_path() && s_.path_lengthening);
+  if (traced && beam_->has_camera()) {
+    b.toward = true;
+    b.peak_toward = toward;
+  }
+  return b;
 }
 
 Rgb MfsIntegrator::higher_orders(int i, const Vec3& p, const Vec3& d, double t, const Rgb& tau_p,

@@ -45,6 +45,8 @@
 // | `path_lengthening`        | boolean                       | false     | the corrected kernel's 1 / cosh loss on paths lengthened by peak deflections |
 // | `filtered_lookups`        | boolean                       | false     | scatter grid read pre-filtered over the camera-side lateral spread |
 // | `source_blur`             | boolean                       | false     | the source (sigma_s times every scattered term) read at a point drawn from the camera-side lateral footprint (D10), so rays near a boundary gather partly outside the medium |
+// | `peak_toward_camera`      | boolean                       | false     | the forward peak alone takes its angular factor from the beam grid's photons (their P_peak towards the camera) instead of peak_eff at the beam's mean-cosine depth (one medium only) |
+// | `exact_light_transmittance` | boolean                     | false     | T_light and T_wide to directional and point lights without the shadow maps: the chord in closed form for one constant-density sphere or box, else a march |
 // | `shadow_map_resolution`   | integer in [8, 1024]          | 64        | deep shadow map nodes along the longest axis |
 //
 // forward_side "light" needs light_path "forward" and photon_transport "exact": the other values are
@@ -87,6 +89,8 @@ struct MfsSettings {
   bool path_lengthening = false;
   bool filtered_lookups = false;
   bool source_blur = false;
+  bool peak_toward_camera = false;
+  bool exact_light_transmittance = false;
   int shadow_map_resolution = 64;
 
   bool forward_light_path() const { return light_path == LightPath::forward; }
@@ -151,6 +155,9 @@ class MfsIntegrator final : public Integrator {
   // Light l's peak-only beam at p for medium i: shadow maps, beam grid (eqs. D8, D9); an area light
   // marches to its sampled point ls instead of reading a map.
   LightBeam light_beam(size_t l, int i, const Vec3& p, const LightSample& ls) const;
+  // exact_light_transmittance: T_light and T_wide from p to the light sample without the shadow maps (a
+  // closed-form chord for one analytic medium, else a march).
+  void exact_light_transmittance(const Vec3& p, const LightSample& ls, Rgb* T_light, Rgb* T_wide) const;
   // The beam from the environment image along wi (marched: full and reduced transmittance, no beam grid).
   LightBeam environment_beam(int i, const Vec3& p, const Vec3& wi) const;
   // The scatter grid's light, taking its last wide scatter at p towards the camera (eq. D12).

@@ -67,6 +67,10 @@ struct LightBeam {
   Rgb T_light;  // plain transmittance to the light (shadow map)
   Rgb T_wide;   // reduced transmittance (T_light for beer_lambert), times R or eq. D5
   Rgb tau_ps;   // light-side peak depth: the beam's angular spread
+  // peak_toward_camera: the traced beam's P_peak towards the camera (replaces peak_eff(tau_ps, mu) on camera
+  // rays) where toward is set.
+  bool toward = false;
+  Rgb peak_toward{0.0};
 };
 // From the shadow maps' T_light and T_wide, and from the beam grid where it covers y (traced: R and the
 // beam's mean cosine); peak_moments: the medium's chi_l^peak; theta2: its peak's mean square angle.

@@ -27,6 +27,7 @@ class PinholeCamera {
     const double sy = (1.0 - 2.0 * py / height_) * tan_half_;
     return normalize(forward_ + right_ * sx + up_ * sy);
   }
+  const Vec3& origin() const { return origin_; }
   // The camera ray through image position (px, py).
   Ray generate_ray(double px, double py) const { return {origin_, direction(px, py)}; }
 

@@ -73,6 +73,8 @@ TEST(Registry, SettingsRoundTripThroughJson) {
                                               {"path_lengthening", true},
                                               {"filtered_lookups", true},
                                               {"source_blur", true},
+                                              {"peak_toward_camera", true},
+                                              {"exact_light_transmittance", true},
                                               {"shadow_map_resolution", 32}});
   expect_round_trip(
       &mfs_settings_from_json,
@@ -85,7 +87,7 @@ TEST(Registry, DefaultsAreWrittenOut) {
   EXPECT_EQ(mfs["large_angle_scatters"], "all");
   EXPECT_EQ(mfs["scatter_grid_resolution"], "auto");
   EXPECT_EQ(mfs["light_path"], "forward");
-  EXPECT_EQ(mfs.size(), 17u);  // every option of the table in mfs.h
+  EXPECT_EQ(mfs.size(), 19u);  // every option of the table in mfs.h
 }
 
 TEST(Registry, UnknownFieldsAndNamesAreErrors) {
