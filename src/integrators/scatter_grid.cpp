@@ -129,6 +129,62 @@ Photon emit_from_media(const EmissionSampler& sampler, const SceneMedia& media, 
   return p;
 }
 
+// Per source: the offset in floats of its single-colour block in a batch's tally (-1: none, the RGB
+// block), its colour (max channel 1) and largest channel.
+struct SourceBlock {
+  int64_t offset = -1;
+  Rgb colour{1.0};
+  int channel = 0;
+};
+
+// Sources whose photons all carry one colour (grey media: a directional, point or spot light, or a
+// constant environment) deposit into a single-colour block of their own (TallyBlock); the others (an
+// environment image, the media's emission, area lights, or any source of coloured media) into the RGB
+// block (first in the tally), which is left out when no source needs it. Sources are numbered as
+// ScatterPhotons::trace numbers them (lights, then the environment, then the emission). Returns the
+// floats of a batch's tally; *rgb_size: those of the RGB block.
+size_t assign_blocks(const SceneContext& ctx, bool grey, size_t lights, size_t sources, size_t nodes,
+                     int coeffs, std::vector<SourceBlock>* blocks, size_t* rgb_size) {
+  blocks->assign(sources, SourceBlock{});
+  size_t mono = 0;
+  for (size_t src = 0; src < sources && grey; ++src) {
+    std::optional<Rgb> colour;
+    if (src < lights) {
+      const Light& light = ctx.lights[src];
+      if (const auto* d = std::get_if<DirectionalLight>(&light)) colour = d->irradiance;
+      if (const auto* p = std::get_if<PointLight>(&light)) colour = p->intensity;
+      if (const auto* p = std::get_if<SpotLight>(&light)) colour = p->intensity;
+    } else if (src == lights && ctx.has_environment && !ctx.env_map) {
+      colour = ctx.environment;
+    }
+    if (!colour || !(max_component(*colour) > 0.0) || !(min_component(*colour) >= 0.0)) continue;
+    SourceBlock& b = (*blocks)[src];
+    b.channel = colour->x >= colour->y ? (colour->x >= colour->z ? 0 : 2) : (colour->y >= colour->z ? 1 : 2);
+    b.colour = *colour / (*colour)[b.channel];
+    b.offset = int64_t(mono++);  // in blocks for now
+  }
+  *rgb_size = mono < sources ? nodes * 3 * coeffs : 0;
+  for (SourceBlock& b : *blocks)
+    if (b.offset >= 0) b.offset = int64_t(*rgb_size + size_t(b.offset) * nodes * coeffs);
+  return *rgb_size + mono * nodes * coeffs;
+}
+
+// Adds wt times node n of a batch's tally (laid out by assign_blocks) to acc (as ScatterGrid::values_
+// lays out a node: channel c at [coeffs c + h]): the RGB block, then each single-colour block times
+// its colour.
+void fold_node(const std::vector<SourceBlock>& blocks, size_t rgb_size, int coeffs, const float* tally,
+               size_t n, double wt, double* acc) {
+  const int rgb_floats = 3 * coeffs;
+  if (rgb_size > 0)
+    for (int i = 0; i < rgb_floats; ++i) acc[i] += wt * tally[n * rgb_floats + i];
+  for (const SourceBlock& b : blocks) {
+    if (b.offset < 0) continue;
+    const float* t = tally + b.offset + n * coeffs;
+    for (int c = 0; c < 3; ++c)
+      for (int h = 0; h < coeffs; ++h) acc[c * coeffs + h] += wt * b.colour[c] * t[h];
+  }
+}
+
 // The photons of one scatter grid: which source and channel photon j belongs to, what its flights
 // deposit and what its real collisions do.
 struct ScatterPhotons {
@@ -144,16 +200,9 @@ struct ScatterPhotons {
   const EmissionSampler* emission;  // null when no medium emits
   Vec3 centre;                      // of the media's bounding sphere, which the photons are aimed at
   double radius;
-  int K;                  // flights after wide scatter 1 .. K - 1 are kept
-  double majorant_scale;  // the share of the majorant that bounds the extinction the photons see
-  // Per source (as trace numbers them): the offset in floats of its single-colour block in a batch's
-  // tally (-1: none, the RGB block), its colour and largest channel.
-  struct SourceBlock {
-    int64_t offset = -1;
-    Rgb colour{1.0};
-    int channel = 0;
-  };
-  std::vector<SourceBlock> blocks;
+  int K;                            // flights after wide scatter 1 .. K - 1 are kept
+  double majorant_scale;            // the share of the majorant that bounds the extinction the photons see
+  std::vector<SourceBlock> blocks;  // per source, as trace numbers them
 
   void trace(size_t j, Rng& rng, PhotonBatch& batch) const;
   bool reflect(const SurfaceHit& hit, Vec3* w, int c, double* weight, int* order, Rng& rng) const;
@@ -319,52 +368,20 @@ void ScatterGrid::trace(const SceneContext& ctx, const std::vector<const PhaseSp
       .majorant_scale =
           s.exact_transport ? 1.0 : majorant_share(ctx.media, [&](int i) { return 1.0 - peak_fraction[i]; }),
       .blocks = {}};
-  // Sources whose photons all carry one colour (grey media: a directional, point or spot light, or a
-  // constant environment) deposit into a single-colour block of their own (TallyBlock); the others
-  // (an environment image, the media's emission, area lights, or any source of coloured media) into
-  // the RGB block, which is left out when no source needs it.
   const size_t nodes = grid_.size();
-  const int rgb_floats = 3 * coeffs_;
-  photons.blocks.resize(sources);
-  size_t mono = 0;
-  for (size_t src = 0; src < sources && grey; ++src) {
-    std::optional<Rgb> colour;
-    if (src < lights) {
-      const Light& light = ctx.lights[src];
-      if (const auto* d = std::get_if<DirectionalLight>(&light)) colour = d->irradiance;
-      if (const auto* p = std::get_if<PointLight>(&light)) colour = p->intensity;
-      if (const auto* p = std::get_if<SpotLight>(&light)) colour = p->intensity;
-    } else if (src == lights && ctx.has_environment && !ctx.env_map) {
-      colour = ctx.environment;
-    }
-    if (!colour || !(max_component(*colour) > 0.0) || !(min_component(*colour) >= 0.0)) continue;
-    auto& b = photons.blocks[src];
-    b.channel = colour->x >= colour->y ? (colour->x >= colour->z ? 0 : 2) : (colour->y >= colour->z ? 1 : 2);
-    b.colour = *colour / (*colour)[b.channel];
-    b.offset = int64_t(mono++);  // in blocks for now
-  }
-  const bool rgb_block = mono < sources;
-  const size_t rgb_size = rgb_block ? nodes * rgb_floats : 0;
-  for (auto& b : photons.blocks)
-    if (b.offset >= 0) b.offset = int64_t(rgb_size + size_t(b.offset) * nodes * coeffs_);
+  size_t rgb_size = 0;
+  const size_t tally_size =
+      assign_blocks(ctx, grey, lights, sources, nodes, coeffs_, &photons.blocks, &rgb_size);
   TallyFold fold;
   fold.nodes = nodes;
-  fold.out_floats = rgb_floats;
+  fold.out_floats = 3 * coeffs_;
   fold.fold = [&](const float* tally, size_t n, double wt, double* acc) {
-    if (rgb_block)
-      for (int i = 0; i < rgb_floats; ++i) acc[i] += wt * tally[n * rgb_floats + i];
-    for (const auto& b : photons.blocks) {
-      if (b.offset < 0) continue;
-      const float* t = tally + b.offset + n * coeffs_;
-      for (int c = 0; c < 3; ++c)
-        for (int h = 0; h < coeffs_; ++h) acc[c * coeffs_ + h] += wt * b.colour[c] * t[h];
-    }
+    fold_node(photons.blocks, rgb_size, coeffs_, tally, n, wt, acc);
   };
   // The batches' sums divided by the node volume: fluence and flux.
   values_ = trace_photons_folded(
-      total, s.seed ^ 0x6d756c7469706c65ull, rgb_size + mono * nodes * coeffs_, 1.0 / grid_.cell_volume(),
-      fold, [&](size_t j, Rng& rng, PhotonBatch& batch) { photons.trace(j, rng, batch); },
-      &rejection_failures_);
+      total, s.seed ^ 0x6d756c7469706c65ull, tally_size, 1.0 / grid_.cell_volume(), fold,
+      [&](size_t j, Rng& rng, PhotonBatch& batch) { photons.trace(j, rng, batch); }, &rejection_failures_);
   build_mips();
 }
 
