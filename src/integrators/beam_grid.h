@@ -23,6 +23,7 @@
 #include "core/node_grid.h"
 #include "integrators/integrator.h"
 #include "integrators/shadow_map.h"
+#include "media/majorant.h"
 #include "transport/phase_split.h"
 
 namespace nimbus {
@@ -32,7 +33,7 @@ class BeamGrid {
   // reduced_maps[l]: light l's T_wide; photons: per light; resolution as ScatterGridSettings.
   BeamGrid(const SceneContext& ctx, const std::vector<const PhaseSplit*>& splits,
            const std::vector<double>& peak_fraction, const std::vector<TransmittanceGrid>& reduced_maps,
-           int photons, int resolution, uint64_t seed);
+           int photons, int resolution, uint64_t seed, const MajorantGrid* majorants = nullptr);
   // R for light `light` at p (trilinear between nodes) and the peak-only light's mean cosine to the
   // straight direction from the light; false (nothing written) outside the grid and for other lights.
   bool lookup(size_t light, const Vec3& p, Rgb* factor, Rgb* mean_cosine) const;

@@ -236,7 +236,7 @@ void ScatterPhotons::trace(size_t j, Rng& rng, PhotonBatch& batch) const {
   double weight = 1.0;
   int order = 0;  // wide scatters so far
   walk_photon(
-      ctx, ph.x, ph.w, majorant_scale, rng, &batch.collisions,
+      ctx, s.majorants ? *s.majorants : ctx.majorants, ph.x, ph.w, majorant_scale, rng, &batch.collisions,
       [&](const Vec3& p) {
         return s.exact_transport ? ctx.media.sigma_t(p)[c] : reduced_sigma_t(ctx.media, p, peak_fraction)[c];
       },
