@@ -63,9 +63,10 @@ struct BeamPhotons {
   size_t per_light;
   Vec3 centre;  // of the node grid's bounding sphere, which the photons are aimed at
   double radius;
-  double majorant_scale;  // the share of the majorant that bounds the peak-scatter rate
-  const Vec3* camera;     // tally P_peak (of medium 0) towards this point, or null
-  int stride;             // floats per node
+  double majorant_scale;          // the share of the majorant that bounds the peak-scatter rate
+  const Vec3* camera;             // tally P_peak (of medium 0) towards this point, or null
+  int stride;                     // floats per node
+  const MajorantGrid* majorants;  // the photons' tracking majorants (null: the scene's)
 
   void trace(size_t j, Rng& rng, PhotonBatch& batch) const;
   Rgb deposit(float* tally, const Vec3& x, const Vec3& w, double t_end, Rgb weight, int c,
@@ -126,7 +127,7 @@ void BeamPhotons::trace(size_t j, Rng& rng, PhotonBatch& batch) const {
   // continuous loss exp(-int sigma_loss) on the weight (zero variance in a uniform medium).
   const auto peak_share = [&](int i) { return peak_fraction[i]; };
   walk_photon(
-      ctx, ph.x, ph.w, majorant_scale, rng, &batch.collisions,
+      ctx, majorants ? *majorants : ctx.majorants, ph.x, ph.w, majorant_scale, rng, &batch.collisions,
       [&](const Vec3& p) {
         ctx.media.eval(p, &walk.mp);
         return scattering_shares(walk.mp, ctx.media.count(), walk.c, peak_share).sum;
@@ -178,7 +179,7 @@ bool BeamPhotons::scatter(const Vec3& xc, Vec3* w, BeamWalk& walk, Rng& rng, Pho
 BeamGrid::BeamGrid(const SceneContext& ctx, const std::vector<const PhaseSplit*>& splits,
                    const std::vector<double>& peak_fraction,
                    const std::vector<TransmittanceGrid>& reduced_maps, int photons, int resolution,
-                   uint64_t seed, const Vec3* camera)
+                   uint64_t seed, const Vec3* camera, const MajorantGrid* majorants)
     : stride_(camera ? kCameraFloats : kBaseFloats) {
   if (camera) camera_ = *camera;
   values_.resize(ctx.lights.size());
@@ -213,7 +214,8 @@ BeamGrid::BeamGrid(const SceneContext& ctx, const std::vector<const PhaseSplit*>
                            .radius = radius,
                            .majorant_scale = scale,
                            .camera = camera ? &camera_ : nullptr,
-                           .stride = stride_};
+                           .stride = stride_,
+                           .majorants = majorants};
     // The batches' sums divided by the node volume.
     values_[l] = trace_photons(
         total, seed ^ 0x7065616b6265616dull ^ (uint64_t(l) << 40), grid_.size() * size_t(stride_),

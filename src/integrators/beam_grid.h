@@ -23,6 +23,7 @@
 #include "core/node_grid.h"
 #include "integrators/integrator.h"
 #include "integrators/shadow_map.h"
+#include "media/majorant.h"
 #include "transport/phase_split.h"
 
 namespace nimbus {
@@ -32,7 +33,8 @@ class BeamGrid {
   // reduced_maps[l]: light l's T_wide; photons: per light; resolution as ScatterGridSettings.
   BeamGrid(const SceneContext& ctx, const std::vector<const PhaseSplit*>& splits,
            const std::vector<double>& peak_fraction, const std::vector<TransmittanceGrid>& reduced_maps,
-           int photons, int resolution, uint64_t seed, const Vec3* camera = nullptr);
+           int photons, int resolution, uint64_t seed, const Vec3* camera = nullptr,
+           const MajorantGrid* majorants = nullptr);
   // R for light `light` at p (trilinear between nodes) and the peak-only light's mean cosine to the
   // straight direction from the light; false (nothing written) outside the grid and for other lights.
   // With a camera, peak_toward (if not null) gets the traced beam's P_peak (medium 0's) towards the camera,

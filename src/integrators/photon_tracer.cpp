@@ -1,6 +1,7 @@
 // The photon tracer's emission and batching (integrators/photon_tracer.h).
 #include "integrators/photon_tracer.h"
 
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -84,8 +85,16 @@ bool grey_media(const SceneContext& ctx) {
   return grey;
 }
 
-std::vector<float> trace_photons(size_t total, uint64_t stream_seed, size_t tally_size, double scale,
-                                 const TracePhoton& trace_photon, uint64_t* rejection_failures) {
+namespace {
+
+// The batches' tallies and the scale of each (planned / traced photons).
+struct TracedBatches {
+  std::vector<PhotonBatch> batch;
+  std::vector<double> scale;
+};
+
+TracedBatches run_batches(size_t total, uint64_t stream_seed, size_t tally_size,
+                          const TracePhoton& trace_photon, uint64_t* rejection_failures) {
   std::vector<PhotonBatch> batch(kPhotonBatches);
   std::vector<double> batch_scale(kPhotonBatches, 1.0);
   tbb::parallel_for(0, kPhotonBatches, [&](int b) {
@@ -100,7 +109,16 @@ std::vector<float> trace_photons(size_t total, uint64_t stream_seed, size_t tall
     }
     batch_scale[b] = j > begin ? double(end - begin) / double(j - begin) : 1.0;
   });
+  for (const PhotonBatch& pb : batch) *rejection_failures += pb.rejection_failures;
+  return {std::move(batch), std::move(batch_scale)};
+}
 
+}  // namespace
+
+std::vector<float> trace_photons(size_t total, uint64_t stream_seed, size_t tally_size, double scale,
+                                 const TracePhoton& trace_photon, uint64_t* rejection_failures) {
+  const auto [batch, batch_scale] =
+      run_batches(total, stream_seed, tally_size, trace_photon, rejection_failures);
   // Sum the batches in order (the same sum for every thread count).
   std::vector<float> sum(tally_size);
   tbb::parallel_for(size_t(0), tally_size, [&](size_t n) {
@@ -108,7 +126,26 @@ std::vector<float> trace_photons(size_t total, uint64_t stream_seed, size_t tall
     for (int b = 0; b < kPhotonBatches; ++b) s += batch_scale[b] * batch[b].tally[n];
     sum[n] = float(s * scale);
   });
-  for (const PhotonBatch& pb : batch) *rejection_failures += pb.rejection_failures;
+  return sum;
+}
+
+std::vector<float> trace_photons_folded(size_t total, uint64_t stream_seed, size_t tally_size, double scale,
+                                        const TallyFold& fold, const TracePhoton& trace_photon,
+                                        uint64_t* rejection_failures) {
+  const auto [batch, batch_scale] =
+      run_batches(total, stream_seed, tally_size, trace_photon, rejection_failures);
+  // Fold the batches node by node, in order (the same sum for every thread count).
+  const int k = fold.out_floats;
+  std::vector<float> sum(fold.nodes * size_t(k));
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, fold.nodes), [&](const tbb::blocked_range<size_t>& r) {
+    std::vector<double> acc(static_cast<size_t>(k));
+    for (size_t n = r.begin(); n != r.end(); ++n) {
+      std::fill(acc.begin(), acc.end(), 0.0);
+      for (int b = 0; b < kPhotonBatches; ++b)
+        fold.fold(batch[b].tally.data(), n, batch_scale[b], acc.data());
+      for (int i = 0; i < k; ++i) sum[n * k + i] = float(acc[i] * scale);
+    }
+  });
   return sum;
 }
 

@@ -63,20 +63,35 @@ using TracePhoton = std::function<void(size_t j, Rng& rng, PhotonBatch& batch)>;
 std::vector<float> trace_photons(size_t total, uint64_t stream_seed, size_t tally_size, double scale,
                                  const TracePhoton& trace_photon, uint64_t* rejection_failures);
 
+// A batch tally laid out otherwise than the result: trace_photons_folded's tally has tally_size floats
+// per batch, and fold(tally, node, weight, acc) adds weight times node `node`'s result (out_floats
+// values) to acc. (The scatter grid keeps one single-colour block per light of grey media, 9 floats per
+// node instead of 27: a third of the cache lines per splat; issue 12.)
+struct TallyFold {
+  size_t nodes = 0;
+  int out_floats = 0;
+  std::function<void(const float* tally, size_t node, double weight, double* acc)> fold;
+};
+// trace_photons with the batches' tallies folded (in order, in double) into nodes x out_floats values.
+std::vector<float> trace_photons_folded(size_t total, uint64_t stream_seed, size_t tally_size, double scale,
+                                        const TallyFold& fold, const TracePhoton& trace_photon,
+                                        uint64_t* rejection_failures);
+
 // The share of the majorant that bounds an extinction which keeps, of each medium i, its absorption
 // and kept(i) (in [0, 1]) of its scattering (the colour grid's tint, at most 1, only lowers it):
 // max over media of max_c (sigma_a + kept sigma_s) / max_c (sigma_a + sigma_s). 1 without media.
 double majorant_share(const SceneMedia& media, const std::function<double(int)>& kept);
 
-// Flies a photon from x along w: delta tracking with real collisions at density sigma(p) (<= the
-// majorant times majorant_scale); on_flight(x, w, t_end) for each flight (t_end infinite when the photon leaves the media;
+// Flies a photon from x along w: delta tracking against `majorants` (the scene's, or the photons'
+// own tighter grid) with real collisions at density sigma(p) (<= the majorant times majorant_scale); on_flight(x, w, t_end) for each flight (t_end infinite when the photon leaves the media;
 // a flight that meets a surface ends there and on_surface(hit, &w) -> bool decides: false absorbs the
 // photon, true sends it on along the new w from the surface),
 // then on_collision(xc, &w) -> bool at each real collision xc (false ends the photon; it may turn w).
 // At most kMaxPhotonEvents collisions; each one that does not end the photon adds 1 to *collisions.
 template <typename Sigma, typename OnFlight, typename OnCollision, typename OnSurface>
-void walk_photon(const SceneContext& ctx, Vec3 x, Vec3 w, double majorant_scale, Rng& rng, double* collisions,
-                 Sigma&& sigma, OnFlight&& on_flight, OnCollision&& on_collision, OnSurface&& on_surface) {
+void walk_photon(const SceneContext& ctx, const MajorantGrid& majorants, Vec3 x, Vec3 w,
+                 double majorant_scale, Rng& rng, double* collisions, Sigma&& sigma, OnFlight&& on_flight,
+                 OnCollision&& on_collision, OnSurface&& on_surface) {
   constexpr double kInf = std::numeric_limits<double>::infinity();
   for (int events = 0; events < kMaxPhotonEvents; ++events, *collisions += 1.0) {
     bool hit = false;
@@ -84,7 +99,7 @@ void walk_photon(const SceneContext& ctx, Vec3 x, Vec3 w, double majorant_scale,
     SurfaceHit surface;
     const bool to_surface = ctx.surfaces.intersect(x, w, kInf, &surface);
     const bool reached =
-        track(ctx.majorants, x, w, surface.t, majorant_scale, rng, [&](const Vec3& p, double maj) {
+        track(majorants, x, w, surface.t, majorant_scale, rng, [&](const Vec3& p, double maj) {
           const double s = sigma(p);
           NIMBUS_DCHECK(s >= 0.0 && s <= maj);  // a real collision's probability s / maj in [0, 1]
           if (rng.uniform() * maj < s) {

@@ -5,6 +5,7 @@
 #include <tbb/parallel_for.h>
 
 #include <cmath>
+#include <optional>
 
 #include "core/check.h"
 #include "core/sh.h"
@@ -37,12 +38,23 @@ void splat(float* tally, const NodeGrid& grid, int floats_per_node, int first, i
   }
 }
 
+// Where a photon's flights go in its batch's tally: the RGB block (per node: channel c at [coeffs c + h],
+// as ScatterGrid::values_), or, for a source whose photons all carry one colour (grey media, a light
+// or a constant environment), that source's single-colour block (per node: coeffs floats, the power
+// in units of `colour`, which ScatterGrid::trace's fold multiplies back in). The single-colour block
+// is a third of the RGB block's floats and cache lines per splat (docs/benchmarks.md, issue 12).
+struct TallyBlock {
+  float* mono = nullptr;  // the source's single-colour block, or null: the RGB block
+  Rgb colour{1.0};        // the source's colour (max channel 1)
+  int channel = 0;        // its largest channel
+};
+
 // Track-length deposit of the flight x + t w, t in [0, t_end] (clipped to the node grid): samples at
 // most kDepositStep spacings apart, each splatting its share of power x length times the harmonics of w
-// (per node: channel c at [coeffs c + h], as ScatterGrid::values_; only the channels from the first
+// (into block.mono when given; else into the RGB block `tally`, where only the channels from the first
 // to the last with non-zero power are touched).
-void deposit_flight(float* tally, const NodeGrid& grid, int bands, const Vec3& x, const Vec3& w, double t_end,
-                    const Rgb& power) {
+void deposit_flight(float* tally, const TallyBlock& block, const NodeGrid& grid, int bands, const Vec3& x,
+                    const Vec3& w, double t_end, const Rgb& power) {
   double t0, t1;
   if (!grid.bounds.intersect(x, w, 0.0, t_end, &t0, &t1)) return;
   const double len = t1 - t0;
@@ -50,12 +62,25 @@ void deposit_flight(float* tally, const NodeGrid& grid, int bands, const Vec3& x
   const int n = std::max(1, int(std::ceil(len / (kDepositStep * grid.min_spacing()))));
   const Rgb v = power * (len / n);
   NIMBUS_DCHECK(min_component(v) >= 0.0 && std::isfinite(max_component(v)));
+  const int coeffs = bands * bands;
+  double y[kShMaxBands * kShMaxBands];
+  if (block.mono) {
+    const double a = v[block.channel];  // v = a colour (the source's photons carry its colour)
+    NIMBUS_DCHECK(std::abs(v.x - a * block.colour.x) <= 1e-9 * a &&
+                  std::abs(v.y - a * block.colour.y) <= 1e-9 * a &&
+                  std::abs(v.z - a * block.colour.z) <= 1e-9 * a);
+    if (!(a > 0.0)) return;
+    sh_eval(w, bands, y);
+    float add[kShMaxBands * kShMaxBands];
+    for (int h = 0; h < coeffs; ++h) add[h] = float(a * y[h]);
+    for (int k = 0; k < n; ++k)
+      splat(block.mono, grid, coeffs, 0, coeffs, x + w * (t0 + (k + 0.5) * len / n), add);
+    return;
+  }
   int c_lo = 0, c_hi = 2;
   while (c_lo < 3 && v[c_lo] == 0.0) ++c_lo;
   while (c_hi >= c_lo && v[c_hi] == 0.0) --c_hi;
   if (c_lo > c_hi) return;
-  const int coeffs = bands * bands;
-  double y[kShMaxBands * kShMaxBands];
   sh_eval(w, bands, y);
   float add[3 * kShMaxBands * kShMaxBands];
   for (int c = c_lo; c <= c_hi; ++c)
@@ -104,6 +129,62 @@ Photon emit_from_media(const EmissionSampler& sampler, const SceneMedia& media, 
   return p;
 }
 
+// Per source: the offset in floats of its single-colour block in a batch's tally (-1: none, the RGB
+// block), its colour (max channel 1) and largest channel.
+struct SourceBlock {
+  int64_t offset = -1;
+  Rgb colour{1.0};
+  int channel = 0;
+};
+
+// Sources whose photons all carry one colour (grey media: a directional, point or spot light, or a
+// constant environment) deposit into a single-colour block of their own (TallyBlock); the others (an
+// environment image, the media's emission, area lights, or any source of coloured media) into the RGB
+// block (first in the tally), which is left out when no source needs it. Sources are numbered as
+// ScatterPhotons::trace numbers them (lights, then the environment, then the emission). Returns the
+// floats of a batch's tally; *rgb_size: those of the RGB block.
+size_t assign_blocks(const SceneContext& ctx, bool grey, size_t lights, size_t sources, size_t nodes,
+                     int coeffs, std::vector<SourceBlock>* blocks, size_t* rgb_size) {
+  blocks->assign(sources, SourceBlock{});
+  size_t mono = 0;
+  for (size_t src = 0; src < sources && grey; ++src) {
+    std::optional<Rgb> colour;
+    if (src < lights) {
+      const Light& light = ctx.lights[src];
+      if (const auto* d = std::get_if<DirectionalLight>(&light)) colour = d->irradiance;
+      if (const auto* p = std::get_if<PointLight>(&light)) colour = p->intensity;
+      if (const auto* p = std::get_if<SpotLight>(&light)) colour = p->intensity;
+    } else if (src == lights && ctx.has_environment && !ctx.env_map) {
+      colour = ctx.environment;
+    }
+    if (!colour || !(max_component(*colour) > 0.0) || !(min_component(*colour) >= 0.0)) continue;
+    SourceBlock& b = (*blocks)[src];
+    b.channel = colour->x >= colour->y ? (colour->x >= colour->z ? 0 : 2) : (colour->y >= colour->z ? 1 : 2);
+    b.colour = *colour / (*colour)[b.channel];
+    b.offset = int64_t(mono++);  // in blocks for now
+  }
+  *rgb_size = mono < sources ? nodes * 3 * coeffs : 0;
+  for (SourceBlock& b : *blocks)
+    if (b.offset >= 0) b.offset = int64_t(*rgb_size + size_t(b.offset) * nodes * coeffs);
+  return *rgb_size + mono * nodes * coeffs;
+}
+
+// Adds wt times node n of a batch's tally (laid out by assign_blocks) to acc (as ScatterGrid::values_
+// lays out a node: channel c at [coeffs c + h]): the RGB block, then each single-colour block times
+// its colour.
+void fold_node(const std::vector<SourceBlock>& blocks, size_t rgb_size, int coeffs, const float* tally,
+               size_t n, double wt, double* acc) {
+  const int rgb_floats = 3 * coeffs;
+  if (rgb_size > 0)
+    for (int i = 0; i < rgb_floats; ++i) acc[i] += wt * tally[n * rgb_floats + i];
+  for (const SourceBlock& b : blocks) {
+    if (b.offset < 0) continue;
+    const float* t = tally + b.offset + n * coeffs;
+    for (int c = 0; c < 3; ++c)
+      for (int h = 0; h < coeffs; ++h) acc[c * coeffs + h] += wt * b.colour[c] * t[h];
+  }
+}
+
 // The photons of one scatter grid: which source and channel photon j belongs to, what its flights
 // deposit and what its real collisions do.
 struct ScatterPhotons {
@@ -119,8 +200,9 @@ struct ScatterPhotons {
   const EmissionSampler* emission;  // null when no medium emits
   Vec3 centre;                      // of the media's bounding sphere, which the photons are aimed at
   double radius;
-  int K;                  // flights after wide scatter 1 .. K - 1 are kept
-  double majorant_scale;  // the share of the majorant that bounds the extinction the photons see
+  int K;                            // flights after wide scatter 1 .. K - 1 are kept
+  double majorant_scale;            // the share of the majorant that bounds the extinction the photons see
+  std::vector<SourceBlock> blocks;  // per source, as trace numbers them
 
   void trace(size_t j, Rng& rng, PhotonBatch& batch) const;
   bool reflect(const SurfaceHit& hit, Vec3* w, int c, double* weight, int* order, Rng& rng) const;
@@ -142,6 +224,10 @@ void ScatterPhotons::trace(size_t j, Rng& rng, PhotonBatch& batch) const {
   const int c = pass;  // the channel whose coefficients drive this photon
   const Photon ph = from_media ? emit_from_media(*emission, ctx.media, double(per_source), rng)
                                : emit(ctx, source, centre, radius, double(per_source), rng);
+  const SourceBlock& sb = blocks[(j / per_source) % sources];
+  const TallyBlock block{.mono = sb.offset >= 0 ? batch.tally.data() + sb.offset : nullptr,
+                         .colour = sb.colour,
+                         .channel = sb.channel};
   Rgb power = ph.power;
   if (!grey)
     for (int k = 0; k < 3; ++k)
@@ -150,13 +236,13 @@ void ScatterPhotons::trace(size_t j, Rng& rng, PhotonBatch& batch) const {
   double weight = 1.0;
   int order = 0;  // wide scatters so far
   walk_photon(
-      ctx, ph.x, ph.w, majorant_scale, rng, &batch.collisions,
+      ctx, s.majorants ? *s.majorants : ctx.majorants, ph.x, ph.w, majorant_scale, rng, &batch.collisions,
       [&](const Vec3& p) {
         return s.exact_transport ? ctx.media.sigma_t(p)[c] : reduced_sigma_t(ctx.media, p, peak_fraction)[c];
       },
       [&](const Vec3& x, const Vec3& w, double t_end) {
         if (order >= first_order)
-          deposit_flight(batch.tally.data(), grid, bands, x, w, t_end, power * weight);
+          deposit_flight(batch.tally.data(), block, grid, bands, x, w, t_end, power * weight);
       },
       [&](const Vec3& xc, Vec3* w) { return scatter(xc, w, c, &weight, &order, rng, batch); },
       [&](const SurfaceHit& hit, Vec3* w) { return reflect(hit, w, c, &weight, &order, rng); });
@@ -264,7 +350,7 @@ void ScatterGrid::trace(const SceneContext& ctx, const std::vector<const PhaseSp
 
   const Bounds media_bounds = ctx.media.bounds();
   const Vec3 extent = media_bounds.hi - media_bounds.lo;
-  const ScatterPhotons photons{
+  ScatterPhotons photons{
       .ctx = ctx,
       .splits = splits,
       .peak_fraction = peak_fraction,
@@ -280,10 +366,21 @@ void ScatterGrid::trace(const SceneContext& ctx, const std::vector<const PhaseSp
       .radius = 0.5 * extent.length() * (1.0 + 1e-9) + 1e-12,
       .K = s.max_wide_scatters <= 0 ? kMaxWideScatters : std::min(s.max_wide_scatters, kMaxWideScatters),
       .majorant_scale =
-          s.exact_transport ? 1.0 : majorant_share(ctx.media, [&](int i) { return 1.0 - peak_fraction[i]; })};
+          s.exact_transport ? 1.0 : majorant_share(ctx.media, [&](int i) { return 1.0 - peak_fraction[i]; }),
+      .blocks = {}};
+  const size_t nodes = grid_.size();
+  size_t rgb_size = 0;
+  const size_t tally_size =
+      assign_blocks(ctx, grey, lights, sources, nodes, coeffs_, &photons.blocks, &rgb_size);
+  TallyFold fold;
+  fold.nodes = nodes;
+  fold.out_floats = 3 * coeffs_;
+  fold.fold = [&](const float* tally, size_t n, double wt, double* acc) {
+    fold_node(photons.blocks, rgb_size, coeffs_, tally, n, wt, acc);
+  };
   // The batches' sums divided by the node volume: fluence and flux.
-  values_ = trace_photons(
-      total, s.seed ^ 0x6d756c7469706c65ull, grid_.size() * 3 * coeffs_, 1.0 / grid_.cell_volume(),
+  values_ = trace_photons_folded(
+      total, s.seed ^ 0x6d756c7469706c65ull, tally_size, 1.0 / grid_.cell_volume(), fold,
       [&](size_t j, Rng& rng, PhotonBatch& batch) { photons.trace(j, rng, batch); }, &rejection_failures_);
   build_mips();
 }

@@ -33,6 +33,7 @@
 #include "core/node_grid.h"
 #include "core/sh.h"
 #include "integrators/integrator.h"
+#include "media/majorant.h"
 #include "transport/phase_split.h"
 
 namespace nimbus {
@@ -45,6 +46,7 @@ struct ScatterGridSettings {
                                 // or wide by their share) or (false) in the similarity medium
   int bands = 3;                // spherical-harmonic bands used at lookup: 2 (l <= 1) or 3 (l <= 2)
   uint64_t seed = 1;
+  const MajorantGrid* majorants = nullptr;  // the photons' tracking majorants (null: the scene's)
 };
 
 class ScatterGrid {

@@ -326,6 +326,23 @@ Bounds DensityGrid::world_bounds() const {
 
 const DensityGrid::Stats& DensityGrid::stats() const { return data_->stats; }
 
+double DensityGrid::max_density_index_exact(const Vec3& a, const Vec3& b) const {
+  // A point p reads voxels floor(p) and floor(p) + 1 per axis (trilinear); clipped as above.
+  int v0[3], v1[3];
+  for (int i = 0; i < 3; ++i) {
+    const double l = std::max(a[i], lo_[i]), h = std::min(b[i], hi_[i]);
+    if (!(l <= h)) return 0.0;
+    v0[i] = static_cast<int>(std::floor(l));
+    v1[i] = static_cast<int>(std::floor(h)) + 1;
+  }
+  auto acc = grid_->getAccessor();
+  float m = 0.0f;
+  for (int x = v0[0]; x <= v1[0]; ++x)
+    for (int y = v0[1]; y <= v1[1]; ++y)
+      for (int z = v0[2]; z <= v1[2]; ++z) m = std::max(m, acc.getValue(nanovdb::Coord(x, y, z)));
+  return double(m) * (1.0 + 1e-6);
+}
+
 double DensityGrid::max_density_index(const Vec3& a, const Vec3& b) const {
   // Cells touched by the box, clipped to [lo, hi]; a point p in cell c reads voxels c and c + 1,
   // which the dilated brick max of c's brick covers.

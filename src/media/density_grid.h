@@ -98,6 +98,10 @@ class DensityGrid {
   // box outside the data. Reads the brick max array (bricks of 8^3 cells; each holds the max over its
   // voxels dilated by one voxel, times (1 + 1e-6) to absorb rounding).
   double max_density_index(const Vec3& index_lo, const Vec3& index_hi) const;
+  // The same from the voxels themselves (those that trilinear reads for a point of the box, negative
+  // ones as 0), times (1 + 1e-6): as tight as a bound on the box can be, and slower (one voxel read
+  // each; for the photons' own majorant grid, MajorantGrid's `exact`).
+  double max_density_index_exact(const Vec3& index_lo, const Vec3& index_hi) const;
   // The maximum density anywhere (the max over all bricks).
   double max_density() const { return max_density_; }
 

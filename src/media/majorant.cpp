@@ -41,7 +41,7 @@ double finest_voxel(const SceneMedia& media) {
 
 }  // namespace
 
-MajorantGrid::MajorantGrid(const SceneMedia& media, int resolution, bool global) {
+MajorantGrid::MajorantGrid(const SceneMedia& media, int resolution, bool global, bool exact) {
   bounds_ = media.bounds();
   if (bounds_.empty()) {
     maj_.assign(1, 0.0f);
@@ -77,7 +77,7 @@ MajorantGrid::MajorantGrid(const SceneMedia& media, int resolution, bool global)
         double m = 0.0;
         for (int i = 0; i < media.count(); ++i) {
           const Medium& med = media.medium(i);
-          const double d = media.max_density(i, cell);
+          const double d = media.max_density(i, cell, exact);
           if (d > 0.0) m += d * max_component(med.sigma_s + med.sigma_a);
         }
         // Emitting cells get at least kEmissionCollisionsPerCell tentative collisions per cell width, so

@@ -22,7 +22,9 @@ class MajorantGrid {
   // resolution: cells along the longest axis (0 = chosen from the media: ~4 voxels per cell for
   // grids, 32 for analytic shapes, at most 128). global = one cell over everything (for tests:
   // the naive tracker that judges the grid).
-  explicit MajorantGrid(const SceneMedia& media, int resolution = 0, bool global = false);
+  // exact: the cells' density maxima from the voxels themselves rather than from the 8^3 bricks'
+  // maxima (SceneMedia::max_density's `exact`): tighter, slower to build (the mfs photons' own grid).
+  explicit MajorantGrid(const SceneMedia& media, int resolution = 0, bool global = false, bool exact = false);
 
   const Bounds& bounds() const { return bounds_; }
   std::array<int, 3> resolution() const { return res_; }

@@ -100,7 +100,7 @@ double SceneMedia::density(int i, const Vec3& p) const {
   return g->density_index(grid_index(s, *g, q));
 }
 
-double SceneMedia::max_density(int i, const Bounds& box) const {
+double SceneMedia::max_density(int i, const Bounds& box, bool exact) const {
   if (!medium_bounds_[i].overlaps(box)) return 0.0;
   const Shape& s = media_[i].shape;
   const Transform& to_local = to_local_[i];
@@ -129,7 +129,7 @@ double SceneMedia::max_density(int i, const Bounds& box) const {
   const Bounds ib = bounds_of_mapped_box(box.lo, box.hi, [&](const Vec3& p) {
     return grid_index(s, *g, to_local.is_identity() ? p : to_local.point(p));
   });
-  return g->max_density_index(ib.lo, ib.hi);
+  return exact ? g->max_density_index_exact(ib.lo, ib.hi) : g->max_density_index(ib.lo, ib.hi);
 }
 
 void SceneMedia::eval(const Vec3& p, MediumPoint* out) const {

@@ -37,7 +37,9 @@ class SceneMedia {
   // looked up at the point the medium's transform takes to p (media without one skip the mapping).
   double density(int i, const Vec3& p) const;
   // A value >= density(i, p) for every p in the world box.
-  double max_density(int i, const Bounds& box) const;
+  // exact: for grids, from the voxels rather than the brick maxima (tighter, slower; see
+  // DensityGrid::max_density_index_exact).
+  double max_density(int i, const Bounds& box, bool exact = false) const;
   void eval(const Vec3& p, MediumPoint* out) const;
   // Total extinction per channel at p.
   Rgb sigma_t(const Vec3& p) const;

@@ -680,5 +680,40 @@ TEST(Mfs, MoreWideScattersAddLight) {
   }
 }
 
+// Grey media: a light's or a constant environment's photons go to a single-colour tally block of their
+// own (9 floats per node), folded back into RGB with the source's colour. The grid must carry each
+// source's colour exactly: channel c over channel 0 is the colour's ratio at every point.
+TEST(Mfs, SingleColourTalliesCarryTheSourcesColours) {
+  for (const char* light :
+       {R"({"type": "directional", "direction": [-1, 0.3, 0.2], "irradiance": [1, 0.5, 0.25]})",
+        R"({"type": "environment", "radiance": [0.2, 0.8, 0.4]})"}) {
+    const Scene scene = test::scene_from_json("{" + test::camera_json(8, 8, 40.0) + R"(,
+      "media": [{"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1}, "sigma_s": 4.0, "sigma_a": 0.05,
+                 "phase": {"type": "hg", "g": 0.8}}],
+      "lights": [)" + std::string(light) + "]}");
+    const bool sun = std::strstr(light, "directional") != nullptr;
+    const Rgb colour = sun ? Rgb(1, 0.5, 0.25) : Rgb(0.2, 0.8, 0.4);
+    const SceneContext ctx(scene);
+    nlohmann::json opts = nlohmann::json::object();
+    opts["photons"] = 4096;
+    const MfsIntegrator mfs(ctx, mfs_settings_from_json(opts, "test"));
+    ASSERT_NE(mfs.scatter_grid(), nullptr);
+    std::array<Rgb, kShMaxBands> chi;
+    for (int l = 0; l < kShMaxBands; ++l) chi[l] = Rgb(std::pow(0.5, l));
+    Rng rng(3, 0);
+    int lit = 0;
+    for (int i = 0; i < 200; ++i) {
+      const Vec3 p(1.6 * rng.uniform() - 0.8, 1.6 * rng.uniform() - 0.8, 1.6 * rng.uniform() - 0.8);
+      const Vec3 w = normalize(Vec3(rng.uniform() - 0.5, rng.uniform() - 0.5, rng.uniform() - 0.5));
+      const Rgb v = mfs.scatter_grid()->scattered(p, w, chi);
+      if (!(v[0] > 0.0)) continue;
+      ++lit;
+      for (int c = 1; c < 3; ++c)
+        EXPECT_NEAR(v[c] / v[0], colour[c] / colour[0], 1e-5 * colour[c] / colour[0]);
+    }
+    EXPECT_GT(lit, 100) << light;
+  }
+}
+
 }  // namespace
 }  // namespace nimbus

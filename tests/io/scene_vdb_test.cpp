@@ -2,10 +2,15 @@
 // volume file, and the majorant grid over a real cloud is conservative and unbiased.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
+#include <cstdio>
 #include <filesystem>
+#include <vector>
 
 #include "integrators/pathtrace.h"
 #include "io/vdb.h"
+#include "media/majorant.h"
 #include "nimbus/error.h"
 #include "support/scenes.h"
 #include "support/stats.h"
@@ -66,6 +71,50 @@ TEST(SceneVdb, MajorantGridIsUnbiasedOnTheDisneyCloud) {
     }
     EXPECT_NEAR(ma.mean, mb.mean, 5 * std::hypot(ma.stderr_mean(), mb.stderr_mean()));
   }
+}
+
+// The photons' exact majorant grid (MajorantGrid's `exact`: cell maxima from the voxels) on the Disney
+// cloud: never below the extinction at points drawn in its non-empty cells, never above the
+// brick-based grid of the same cells, and tighter in all (the photons' null collisions fell from 73 % to
+// 53 % of their lookups with it; docs/benchmarks.md).
+TEST(SceneVdb, ExactMajorantGridBoundsTheCloudAndIsTighter) {
+  const auto cloud = kShared / "data/volumes/wdas_cloud_sixteenth.vdb";
+  if (!std::filesystem::exists(cloud)) GTEST_SKIP();
+  const Scene scene = test::scene_from_json(cloud_scene(cloud.string()));
+  const SceneContext ctx(scene);
+  const auto r = ctx.majorants.resolution();
+  const int res = std::max({r[0], r[1], r[2]});
+  const MajorantGrid brick(ctx.media, res), exact(ctx.media, res, false, true);
+  ASSERT_EQ(brick.resolution(), exact.resolution());
+  const auto n = exact.resolution();
+  const Vec3 lo = exact.bounds().lo, cell = (exact.bounds().hi - lo) / Vec3(n[0], n[1], n[2]);
+  double sum_brick = 0.0, sum_exact = 0.0;
+  std::vector<std::array<int, 3>> filled;
+  for (int z = 0; z < n[2]; ++z)
+    for (int y = 0; y < n[1]; ++y)
+      for (int x = 0; x < n[0]; ++x) {
+        const double b = brick.cell_majorant(x, y, z), e = exact.cell_majorant(x, y, z);
+        ASSERT_LE(e, b * (1.0 + 1e-5)) << x << " " << y << " " << z;
+        sum_brick += b, sum_exact += e;
+        if (e > 0.0) filled.push_back({x, y, z});
+      }
+  std::printf("exact majorants: %.3f of the brick-based ones' sum, %zu non-empty cells\n",
+              sum_exact / sum_brick, filled.size());
+  EXPECT_LT(sum_exact, 0.8 * sum_brick);
+  ASSERT_FALSE(filled.empty());
+  Rng rng(7, 0);
+  int checked = 0;
+  double ratio_max = 0.0;
+  for (int i = 0; i < 200000; ++i) {
+    const auto& c = filled[std::min(filled.size() - 1, size_t(rng.uniform() * filled.size()))];
+    const Vec3 p = lo + Vec3(c[0] + rng.uniform(), c[1] + rng.uniform(), c[2] + rng.uniform()) * cell;
+    const double s = max_component(ctx.media.sigma_t(p)), m = exact.cell_majorant(c[0], c[1], c[2]);
+    ratio_max = std::max(ratio_max, s / m);
+    ASSERT_LE(s, m) << p.x << " " << p.y << " " << p.z;
+    ++checked;
+  }
+  std::printf("largest extinction / exact majorant at %d points: %.4f\n", checked, ratio_max);
+  EXPECT_GT(ratio_max, 0.5);  // the bound is tight somewhere (a loose one would pass the test above)
 }
 
 }  // namespace
