@@ -1,7 +1,9 @@
 // A deep shadow map: per light, a grid of transmittance towards the light over the media's bounds,
-// built once by a deterministic midpoint march in optical-depth steps and read back with trilinear
+// built once by deterministic midpoint marches in optical-depth steps and read back with trilinear
 // interpolation (PVR's cached-transmittance occluder). For directional, point and spot lights (towards
 // light_centre); area lights are marched to a sampled point instead (integrators/area_light_view.h).
+// A directional light's map is swept slice by slice towards the light (MapBuild); the others march
+// from every node to the light.
 #pragma once
 
 #include <vector>
@@ -25,27 +27,41 @@ Rgb reduced_sigma_t(const SceneMedia& media, const Vec3& p, const std::vector<do
 Rgb marched_transmittance(const SceneMedia& media, const MajorantGrid& grid, const Vec3& p, const Vec3& w,
                           double tmax, double tau_step, const std::vector<double>& peak_fraction = {});
 
+// How a map is built. march: every node marches to the light, O(N) lookups per node (the reference).
+// sweep (directional lights; the others march): the node slices across the axis most aligned with
+// the light (per node spacing) are visited from the one nearest the light, and a node takes the
+// transmittance `stride` slices nearer the light, bilinearly interpolated in that slice (1 outside the
+// media's bounds), times its own march over that short segment: O(stride) lookups per node. The
+// interpolation blurs the map across the light's direction by about sqrt(slices / stride) x 0.5 node
+// spacings at worst (tests/integrators/shadow_map_test.cpp measures it against the march).
+struct MapBuild {
+  bool sweep = true;
+  int stride = 2;     // slices per sweep step, >= 1
+  bool cubic = true;  // Catmull-Rom interpolation in the slice (kept within the middle nodes), else bilinear
+};
+
 class TransmittanceGrid {
  public:
   // resolution: nodes along the longest axis of the media's bounds.
   // peak_fraction: see reduced_sigma_t (empty: plain extinction).
   TransmittanceGrid(const SceneMedia& media, const MajorantGrid& grid, const Light& light, int resolution,
-                    double tau_step, const std::vector<double>& peak_fraction = {});
+                    double tau_step, const std::vector<double>& peak_fraction = {}, MapBuild how = {});
   TransmittanceGrid() = default;  // empty (every lookup 0) until build_pair fills it
-  // A light's map of the plain extinction and its map of the reduced one (peak_fraction) from one march
-  // per node: the march's steps depend on the majorant grid only, so both see the same points and each
-  // equals the map built alone (one density lookup per step instead of two).
+  // A light's map of the plain extinction and its map of the reduced one (peak_fraction) from one walk:
+  // the marches' steps depend on the majorant grid only, so both see the same points and each equals
+  // the map built alone (one density lookup per step instead of two).
   static void build_pair(const SceneMedia& media, const MajorantGrid& grid, const Light& light,
                          int resolution, double tau_step, const std::vector<double>& peak_fraction,
-                         TransmittanceGrid* full, TransmittanceGrid* reduced);
+                         TransmittanceGrid* full, TransmittanceGrid* reduced, MapBuild how = {});
   Rgb lookup(const Vec3& p) const;
   size_t memory_bytes() const { return values_.size() * sizeof(float); }
 
  private:
-  // The node grid on the media's bounds; fills every node with one_node(position, T, T2) (T2 may be
-  // null) into values_ (and second->values_ when given).
-  template <typename OneNode>
-  void fill(const MajorantGrid& grid, int resolution, TransmittanceGrid* second, OneNode&& one_node);
+  // Builds the full map (plain extinction) into `full` and the reduced one into `reduced` (either may be
+  // null) on the node grid of the media's bounds.
+  static void build(const SceneMedia& media, const MajorantGrid& grid, const Light& light, int resolution,
+                    double tau_step, const std::vector<double>& peak_fraction, TransmittanceGrid* full,
+                    TransmittanceGrid* reduced, MapBuild how);
 
   NodeGrid grid_;              // nodes on the media's bounds (node_grid_spanning)
   std::vector<float> values_;  // rgb per node
