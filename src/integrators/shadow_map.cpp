@@ -3,6 +3,9 @@
 
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
+#include <cmath>
+
 #include "integrators/tracking.h"
 #include "scene/lights.h"
 
@@ -36,17 +39,19 @@ void TransmittanceGrid::fill(const MajorantGrid& grid, int resolution, Transmitt
     bounds.hi = Vec3(1.0);
   }
   grid_ = node_grid_spanning(bounds, resolution);
-  values_.assign(grid_.size() * 3, 1.0f);
-  if (second) second->grid_ = grid_, second->values_.assign(grid_.size() * 3, 1.0f);
+  values_.assign(grid_.size() * 3, 0.0f);
+  if (second) second->grid_ = grid_, second->values_.assign(grid_.size() * 3, 0.0f);
+  // Nodes keep the optical depth -log T: lookups interpolate it and exponentiate (see lookup).
+  auto depth = [](double T) { return float(-std::log(std::max(T, 1e-300))); };
   tbb::parallel_for(0, grid_.nodes[2], [&](int z) {
     for (int y = 0; y < grid_.nodes[1]; ++y) {
       for (int x = 0; x < grid_.nodes[0]; ++x) {
         Rgb T(1.0), T2(1.0);
         one_node(grid_.position(x, y, z), &T, second ? &T2 : nullptr);
         const size_t i = grid_.index(x, y, z) * 3;
-        for (int c = 0; c < 3; ++c) values_[i + c] = float(T[c]);
+        for (int c = 0; c < 3; ++c) values_[i + c] = depth(T[c]);
         if (second)
-          for (int c = 0; c < 3; ++c) second->values_[i + c] = float(T2[c]);
+          for (int c = 0; c < 3; ++c) second->values_[i + c] = depth(T2[c]);
       }
     }
   });
@@ -92,12 +97,17 @@ void TransmittanceGrid::build_pair(const SceneMedia& media, const MajorantGrid& 
 
 Rgb TransmittanceGrid::lookup(const Vec3& p) const {
   const TrilinearStencil st = grid_.stencil(p);
-  Rgb r(0.0);
+  // Interpolated in optical depth, not in transmittance: exp is convex, so a lerp of T between a node
+  // the light reaches and one deep in shadow is too bright (by up to ~50 % where the light grazes a dense
+  // medium's boundary, the backlit spheres' rim; docs/validation/render.md), while the depth along the
+  // light's path varies smoothly.
+  if (values_.empty()) return Rgb(0.0);
+  Rgb tau(0.0);
   for (int k = 0; k < 8; ++k) {
     const float* v = &values_[st.node[k] * 3];
-    r += Rgb(v[0], v[1], v[2]) * st.weight[k];
+    tau += Rgb(v[0], v[1], v[2]) * st.weight[k];
   }
-  return r;
+  return exp(-tau);
 }
 
 }  // namespace nimbus

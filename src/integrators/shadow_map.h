@@ -48,7 +48,7 @@ class TransmittanceGrid {
   void fill(const MajorantGrid& grid, int resolution, TransmittanceGrid* second, OneNode&& one_node);
 
   NodeGrid grid_;              // nodes on the media's bounds (node_grid_spanning)
-  std::vector<float> values_;  // rgb per node
+  std::vector<float> values_;  // optical depth -log T per node, rgb
 };
 
 }  // namespace nimbus
