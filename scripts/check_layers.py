@@ -140,7 +140,7 @@ def long_functions(path, lines):
 TEST_DEFINITION = [
     re.compile(r"^(?:static\s+|inline\s+|constexpr\s+|const\s+)*[\w:<>,\s&*\[\]]+?[\s&*](\w+)\s*\([^;]*$"),
     re.compile(r"^(?:struct|class|enum(?:\s+class)?)\s+(\w+)\s*[{:]"),
-    re.compile(r"^(?:static\s+)?(?:constexpr|const)\s+[\w:<>]+\s+(\w+)\s*(?:=|\[|\{)"),
+    re.compile(r"^(?:static\s+)?(?:constexpr|const)\s+[\w:<>]+(?:\s*[*&]\s*|\s+)(?:const\s+)?(\w+)\s*(?:=|\[|\{)"),
     re.compile(r"^using\s+(\w+)\s*="),
     re.compile(r"^#define\s+(\w+)"),
 ]

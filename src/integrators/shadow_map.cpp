@@ -6,7 +6,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <limits>
 
 #include "integrators/tracking.h"
 #include "scene/lights.h"
@@ -67,13 +66,6 @@ void segment_depths(const SceneMedia& media, const MajorantGrid& grid,
   });
 }
 
-// -ln T per channel (infinite where T is 0).
-Rgb depth_of(const Rgb& T) {
-  Rgb tau;
-  for (int c = 0; c < 3; ++c) tau[c] = T[c] > 0.0 ? -std::log(T[c]) : std::numeric_limits<double>::infinity();
-  return tau;
-}
-
 // A constant offset `d` (in node spacings) along one axis of a slice, split into whole nodes and a
 // fraction in [0, 1) (snapped to a whole node within 1e-9: a light along a node diagonal), and the
 // weights of the nodes whole - 1 ... whole + 2 around it: linear, or Catmull-Rom (cubic).
@@ -115,15 +107,16 @@ struct AxisOffset {
   }
 };
 
-// The node values being filled: the full map and the reduced one (either may be null), rgb per node.
+// The node values being filled: the full map and the reduced one (either may be null), the optical
+// depth to the light per node, rgb (lookups interpolate it and exponentiate; see lookup).
 struct MapValues {
   NodeGrid g;
   std::vector<float>* full;
   std::vector<float>* reduced;
-  void store(size_t node, const Rgb& T_full, const Rgb& T_reduced) const {
+  void store(size_t node, const Rgb& tau_full, const Rgb& tau_reduced) const {
     for (int c = 0; c < 3; ++c) {
-      if (full) (*full)[node * 3 + c] = float(T_full[c]);
-      if (reduced) (*reduced)[node * 3 + c] = float(T_reduced[c]);
+      if (full) (*full)[node * 3 + c] = float(tau_full[c]);
+      if (reduced) (*reduced)[node * 3 + c] = float(tau_reduced[c]);
     }
   }
 };
@@ -143,7 +136,7 @@ void march_every_node(const SceneMedia& media, const MajorantGrid& grid, const L
         Rgb tau, tau_reduced;
         segment_depths(media, grid, peak_fraction, p, wi, distance, tau_step, maps.full, Rgb(0.0),
                        maps.reduced, Rgb(0.0), &tau, &tau_reduced);
-        maps.store(g.index(x, y, z), exp(-tau), exp(-tau_reduced));
+        maps.store(g.index(x, y, z), tau, tau_reduced);
       }
   });
 }
@@ -172,7 +165,8 @@ void sweep_towards(const SceneMedia& media, const MajorantGrid& grid, const Vec3
     const double t_seg = span * g.spacing[a] / std::abs(w[a]);
     const AxisOffset off_b(w[b] * t_seg / g.spacing[b], how.cubic),
         off_c(w[c] * t_seg / g.spacing[c], how.cubic);
-    // The transmittance in slice j where a node's segment of t_seg towards the light meets it.
+    // The optical depth in slice j where a node's segment of t_seg towards the light meets it (depth,
+    // not transmittance: it is the smoother of the two, and a lerp of T errs by the convexity of exp).
     const auto in_slice = [&](const std::vector<float>& v, int kb, int kc) {
       Rgb column[4];
       for (int qc = 0; qc < 4; ++qc) {
@@ -187,19 +181,18 @@ void sweep_towards(const SceneMedia& media, const MajorantGrid& grid, const Vec3
     };
     tbb::parallel_for(0, nc, [&](int kc) {
       for (int kb = 0; kb < nb; ++kb) {
-        // 1 where the segment's end is outside the bounds: the ray does not come back in.
-        Rgb T_in_full(1.0), T_in_reduced(1.0);
+        // 0 where the segment's end is outside the bounds: the ray does not come back in.
+        Rgb in_full(0.0), in_reduced(0.0);
         if (off_b.inside(kb, nb) && off_c.inside(kc, nc)) {
-          if (maps.full) T_in_full = in_slice(*maps.full, kb, kc);
-          if (maps.reduced) T_in_reduced = in_slice(*maps.reduced, kb, kc);
+          if (maps.full) in_full = in_slice(*maps.full, kb, kc);
+          if (maps.reduced) in_reduced = in_slice(*maps.reduced, kb, kc);
         }
         std::array<int, 3> at;
         at[a] = k, at[b] = kb, at[c] = kc;
         Rgb tau, tau_reduced;
         segment_depths(media, grid, peak_fraction, g.position(at[0], at[1], at[2]), w, t_seg, tau_step,
-                       maps.full, depth_of(T_in_full), maps.reduced, depth_of(T_in_reduced), &tau,
-                       &tau_reduced);
-        maps.store(index(k, kb, kc), T_in_full * exp(-tau), T_in_reduced * exp(-tau_reduced));
+                       maps.full, in_full, maps.reduced, in_reduced, &tau, &tau_reduced);
+        maps.store(index(k, kb, kc), in_full + tau, in_reduced + tau_reduced);
       }
     });
   }
@@ -217,7 +210,7 @@ void TransmittanceGrid::build(const SceneMedia& media, const MajorantGrid& grid,
   }
   const NodeGrid g = node_grid_spanning(bounds, resolution);
   for (TransmittanceGrid* m : {full, reduced})
-    if (m) m->grid_ = g, m->values_.assign(g.size() * 3, 1.0f);
+    if (m) m->grid_ = g, m->values_.assign(g.size() * 3, 0.0f);
   const MapValues maps{g, full ? &full->values_ : nullptr, reduced ? &reduced->values_ : nullptr};
   if (const auto* sun = std::get_if<DirectionalLight>(&light); sun && how.sweep)
     sweep_towards(media, grid, -sun->direction, tau_step, peak_fraction, how, maps);
@@ -243,12 +236,17 @@ void TransmittanceGrid::build_pair(const SceneMedia& media, const MajorantGrid& 
 
 Rgb TransmittanceGrid::lookup(const Vec3& p) const {
   const TrilinearStencil st = grid_.stencil(p);
-  Rgb r(0.0);
+  // Interpolated in optical depth, not in transmittance: exp is convex, so a lerp of T between a node
+  // the light reaches and one deep in shadow is too bright (by up to ~50 % where the light grazes a dense
+  // medium's boundary, the backlit spheres' rim; docs/validation/render.md), while the depth along the
+  // light's path varies smoothly.
+  if (values_.empty()) return Rgb(0.0);
+  Rgb tau(0.0);
   for (int k = 0; k < 8; ++k) {
     const float* v = &values_[st.node[k] * 3];
-    r += Rgb(v[0], v[1], v[2]) * st.weight[k];
+    tau += Rgb(v[0], v[1], v[2]) * st.weight[k];
   }
-  return r;
+  return exp(-tau);
 }
 
 }  // namespace nimbus

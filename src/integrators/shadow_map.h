@@ -1,6 +1,7 @@
 // A deep shadow map: per light, a grid of transmittance towards the light over the media's bounds,
-// built once by deterministic midpoint marches in optical-depth steps and read back with trilinear
-// interpolation (PVR's cached-transmittance occluder). For directional, point and spot lights (towards
+// built once by deterministic midpoint marches in optical-depth steps, kept as optical depth per node and
+// read back by trilinear interpolation of the depth (PVR's cached-transmittance occluder; the depth, not
+// T, because a lerp of T errs by the convexity of exp). For directional, point and spot lights (towards
 // light_centre); area lights are marched to a sampled point instead (integrators/area_light_view.h).
 // A directional light's map is swept slice by slice towards the light (MapBuild); the others march
 // from every node to the light.
@@ -30,8 +31,8 @@ Rgb marched_transmittance(const SceneMedia& media, const MajorantGrid& grid, con
 // How a map is built. march: every node marches to the light, O(N) lookups per node (the reference).
 // sweep (directional lights; the others march): the node slices across the axis most aligned with
 // the light (per node spacing) are visited from the one nearest the light, and a node takes the
-// transmittance `stride` slices nearer the light, bilinearly interpolated in that slice (1 outside the
-// media's bounds), times its own march over that short segment: O(stride) lookups per node. The
+// optical depth `stride` slices nearer the light, interpolated in that slice (0 outside the media's
+// bounds), plus its own march over that short segment: O(stride) lookups per node. The
 // interpolation blurs the map across the light's direction by about sqrt(slices / stride) x 0.5 node
 // spacings at worst (tests/integrators/shadow_map_test.cpp measures it against the march).
 struct MapBuild {
@@ -64,7 +65,7 @@ class TransmittanceGrid {
                     TransmittanceGrid* reduced, MapBuild how);
 
   NodeGrid grid_;              // nodes on the media's bounds (node_grid_spanning)
-  std::vector<float> values_;  // rgb per node
+  std::vector<float> values_;  // optical depth -log T per node, rgb
 };
 
 }  // namespace nimbus

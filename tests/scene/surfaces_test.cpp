@@ -124,7 +124,7 @@ void expect_radiance(const std::array<MeanAccumulator, 3>& m, const Rgb& exact, 
   }
 }
 
-const char* kIntegrators[] = {"pathtrace", "single", "octave", "mfs"};
+const char* kSurfaceIntegrators[] = {"pathtrace", "single", "octave", "mfs"};
 int samples_for(const std::string& type) { return type == "pathtrace" ? 80000 : 16000; }
 
 // A diffuse ground under an absorbing slab, lit by a sun: the radiance of a ground point seen through
@@ -143,7 +143,7 @@ TEST(SurfaceLight, DiffuseGroundUnderAnAbsorbingSlabIsExact) {
   Rgb exact;
   for (int c = 0; c < 3; ++c)
     exact[c] = albedo[c] / kPi * 2.0 * cos_sun * std::exp(-sigma_a[c] * (1.0 / cos_sun + 1.0 / cos_view));
-  for (const std::string type : kIntegrators) {
+  for (const std::string type : kSurfaceIntegrators) {
     std::vector<CameraSample> cs;
     expect_radiance(surface_mean_radiance(scene, type, {o, d}, samples_for(type), &cs), exact, type);
     EXPECT_NEAR(cs[0].depth, length(target - o), 1e-5) << type;
@@ -171,7 +171,7 @@ TEST(SurfaceLight, DiffuseSphereInsideAnAbsorbingMediumIsExact) {
   const double camera_leg = t - (-2.0 - o.y) / d.y;  // from the box's face y = -2 to the sphere
   ASSERT_GT(dot(n, l), 0.1);
   const double exact = 0.6 / kPi * 3.0 * dot(n, l) * std::exp(-0.4 * (to_box + camera_leg));
-  for (const std::string type : kIntegrators)
+  for (const std::string type : kSurfaceIntegrators)
     expect_radiance(surface_mean_radiance(scene, type, {o, d}, samples_for(type)), Rgb(exact), type);
 }
 
@@ -183,7 +183,7 @@ TEST(SurfaceLight, AHoldoutIsBlackAndRecordsTheTransmittanceToIt) {
     "lights": [{"type": "directional", "direction": [0, 1, -1], "irradiance": 3},
                {"type": "environment", "radiance": 0.5}]})");
   const Ray ray{Vec3(0, -5, 0), Vec3(0, 1, 0)};
-  for (const std::string type : kIntegrators) {
+  for (const std::string type : kSurfaceIntegrators) {
     std::vector<CameraSample> cs;
     const auto m = surface_mean_radiance(scene, type, ray, samples_for(type) / 10, &cs);
     MeanAccumulator holdout;
@@ -208,7 +208,7 @@ TEST(SurfaceLight, ARoofShadowsTheMediumCompletely) {
     "lights": [{"type": "directional", "direction": [0.1, 0.2, -1], "irradiance": 5},
                {"type": "point", "position": [0, 0, 3], "intensity": 4}]})");
   Rng dirs(5, 6);
-  for (const std::string type : kIntegrators) {
+  for (const std::string type : kSurfaceIntegrators) {
     for (int k = 0; k < 4; ++k) {
       const Vec3 d = normalize(Vec3(dirs.uniform() - 0.5, 4.0, dirs.uniform() - 0.7));
       const auto m = surface_mean_radiance(scene, type, {Vec3(0, -5, 0), d}, 200);
