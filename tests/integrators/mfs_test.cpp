@@ -381,9 +381,11 @@ TEST(Mfs, BeamGridReproducesTheStraightBeamWithoutDeflection) {
   EXPECT_LT(err_traced / n, 0.015);
 }
 
-// Peak-only paths in a backlit sphere of optical radius 6: the straight-line beam ignores that peak
-// deflections lengthen the paths and carry light out through the sides (+20 % here); the traced beam
-// accounts for both.
+// Peak-only paths in a backlit sphere of optical radius 6: the traced beam accounts for peak deflections
+// lengthening the paths and carrying light out through the sides. (The straight-line beam was +20 % here
+// while the shadow maps interpolated transmittance; with optical depth interpolated it is +1.2 % and the
+// traced beam -3.1 %: most of that +20 % was the maps' lerp of T at the sphere's rim, so the two are no
+// longer compared.)
 TEST(Mfs, ThickPeakOnlyPathsMatchThePathTracerWithTheTracedBeam) {
   Scene scene = test::scene_from_json("{" + test::camera_json(24, 24, 40.0) + R"(,
     "media": [{"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1}, "sigma_s": 6.0, "sigma_a": 0.06,
@@ -403,7 +405,7 @@ TEST(Mfs, ThickPeakOnlyPathsMatchThePathTracerWithTheTracedBeam) {
   std::printf("thick peak-only paths: mfs traced beam %.5f straight %.5f pathtrace %.5f\n", traced[0],
               straight[0], ref[0]);
   EXPECT_NEAR(traced[0], ref[0], 0.08 * ref[0]);
-  EXPECT_LT(std::abs(traced[0] - ref[0]), std::abs(straight[0] - ref[0]));
+  EXPECT_NEAR(straight[0], ref[0], 0.08 * ref[0]);
 }
 
 // Paths with at most one wide scatter in a side-lit sphere of optical radius 5 against the path
