@@ -117,8 +117,10 @@ TracedBatches run_batches(size_t total, uint64_t stream_seed, size_t tally_size,
 
 std::vector<float> trace_photons(size_t total, uint64_t stream_seed, size_t tally_size, double scale,
                                  const TracePhoton& trace_photon, uint64_t* rejection_failures) {
-  const auto [batch, batch_scale] =
-      run_batches(total, stream_seed, tally_size, trace_photon, rejection_failures);
+  // (Named, not a structured binding: clang 14 cannot capture one in the lambdas below.)
+  const TracedBatches traced = run_batches(total, stream_seed, tally_size, trace_photon, rejection_failures);
+  const std::vector<PhotonBatch>& batch = traced.batch;
+  const std::vector<double>& batch_scale = traced.scale;
   // Sum the batches in order (the same sum for every thread count).
   std::vector<float> sum(tally_size);
   tbb::parallel_for(size_t(0), tally_size, [&](size_t n) {
@@ -132,8 +134,10 @@ std::vector<float> trace_photons(size_t total, uint64_t stream_seed, size_t tall
 std::vector<float> trace_photons_folded(size_t total, uint64_t stream_seed, size_t tally_size, double scale,
                                         const TallyFold& fold, const TracePhoton& trace_photon,
                                         uint64_t* rejection_failures) {
-  const auto [batch, batch_scale] =
-      run_batches(total, stream_seed, tally_size, trace_photon, rejection_failures);
+  // (Named, not a structured binding: clang 14 cannot capture one in the lambdas below.)
+  const TracedBatches traced = run_batches(total, stream_seed, tally_size, trace_photon, rejection_failures);
+  const std::vector<PhotonBatch>& batch = traced.batch;
+  const std::vector<double>& batch_scale = traced.scale;
   // Fold the batches node by node, in order (the same sum for every thread count).
   const int k = fold.out_floats;
   std::vector<float> sum(fold.nodes * size_t(k));
