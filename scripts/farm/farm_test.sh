@@ -82,11 +82,14 @@ same split/frame.exr local/one.exr 0
 echo "== 3. a task killed midway, then re-submitted"
 sed 's/"spp": 8/"spp": 32768/' one.json > long.json
 jid=$("$farm/submit.sh" sequence long.json 1 'kill/long.$F.exr')
-for _ in $(seq 240); do  # until the task's nimbus renders (this one node is this machine), then 2 s more
+# Until the task's nimbus runs (this one node is this machine), then 5 s more: nimbus writes a partial
+# image only once its first pass (1 spp) has ended, after the scene's load (2 s was once too short on a
+# loaded machine: "interrupted before the first pass ended"); 32768 spp take minutes.
+for _ in $(seq 240); do
   pgrep -f -- "render --quiet $work/long.json" >/dev/null && break
   sleep 0.25
 done
-sleep 2
+sleep 5
 scancel "$jid"
 wait_jobs "$jid"
 [[ -f kill/long.1.partial.exr && ! -f kill/long.1.exr ]] || { echo "farm_test: no partial image after the kill" >&2; ls -R kill >&2; exit 1; }
