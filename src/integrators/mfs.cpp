@@ -349,8 +349,8 @@ LightBeam MfsIntegrator::environment_beam(int i, const Vec3& p, const Vec3& wi) 
 void MfsIntegrator::exact_light_transmittance(const Vec3& p, const LightSample& ls, Rgb* T_light,
                                               Rgb* T_wide) const {
   // One constant-density sphere or box: the chord to the light in closed form. The shadow maps'
-  // trilinear interpolation over-estimates T where the light grazes a sharp boundary (the chord grows
-  // like sqrt of the distance to the tangent point, T is convex there): a backlit sphere's rim.
+  // interpolation over-estimates T where the light grazes a sharp boundary (the chord grows like sqrt of
+  // the distance to the tangent point): a backlit sphere's rim (less since the maps interpolate depth).
   double t0 = 0.0, t1 = 0.0;
   if (ctx_.analytic.active() && ctx_.media.count() == 1) {
     if (!ctx_.analytic.chord(0, p, ls.wi, ls.distance, &t0, &t1) || !(t1 > t0)) {
