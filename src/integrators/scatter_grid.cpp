@@ -4,6 +4,7 @@
 
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <cmath>
 #include <optional>
 
@@ -196,7 +197,8 @@ struct ScatterPhotons {
   int bands;
   bool grey;      // one pass carrying RGB power (else one pass per channel)
   size_t lights;  // light sources (then the environment, then the media's emission, if any)
-  size_t sources, per_source;
+  size_t sources;
+  std::vector<size_t> first;        // source i's photons are first[i] .. first[i + 1] - 1 of each pass
   const EmissionSampler* emission;  // null when no medium emits
   Vec3 centre;                      // of the media's bounding sphere, which the photons are aimed at
   double radius;
@@ -211,20 +213,24 @@ struct ScatterPhotons {
 };
 
 void ScatterPhotons::trace(size_t j, Rng& rng, PhotonBatch& batch) const {
-  const int pass = int(j / (sources * per_source));
-  size_t source = (j / per_source) % sources;
+  const size_t per_pass = first.back();
+  const int pass = int(j / per_pass);
+  const size_t k = j % per_pass;
+  const size_t src = size_t(std::upper_bound(first.begin(), first.end(), k) - first.begin()) - 1;
+  const double n = double(first[src + 1] - first[src]);  // the source's photons per pass
+  size_t source = src;
   if (source >= lights) source = ctx.lights.size();  // the environment
   // The constant environment's light is smooth in angle: the grid carries it from its entry (order 0).
   // So is the media's emission (isotropic, the last source): the grid carries it from its first flight.
   // An environment image is not (a sun in it): like a light, mfs takes its first wide scatter on the
   // camera march, and the grid carries its photons after that.
-  const bool from_media = emission && (j / per_source) % sources == sources - 1;
+  const bool from_media = emission && src == sources - 1;
   const bool light_like = source < ctx.lights.size() || (source == ctx.lights.size() && ctx.env_map);
   const int first_order = light_like && !from_media ? 1 : 0;
   const int c = pass;  // the channel whose coefficients drive this photon
-  const Photon ph = from_media ? emit_from_media(*emission, ctx.media, double(per_source), rng)
-                               : emit(ctx, source, centre, radius, double(per_source), rng);
-  const SourceBlock& sb = blocks[(j / per_source) % sources];
+  const Photon ph =
+      from_media ? emit_from_media(*emission, ctx.media, n, rng) : emit(ctx, source, centre, radius, n, rng);
+  const SourceBlock& sb = blocks[src];
   const TallyBlock block{.mono = sb.offset >= 0 ? batch.tally.data() + sb.offset : nullptr,
                          .colour = sb.colour,
                          .channel = sb.channel};
@@ -311,6 +317,40 @@ bool ScatterPhotons::scatter(const Vec3& xc, Vec3* w, int c, double* weight, int
   return true;
 }
 
+// The photons of each source (numbered as ScatterPhotons::trace numbers them) as first[i] ..
+// first[i + 1] - 1 of a pass: a share s.power_share p_i / sum p + (1 - s.power_share) / sources of
+// s.photons (at least 1), p_i the luminance of source i's power towards the media's bounding sphere
+// (the mean of 64 of its photons' power, each emitted as the only one; exact for a directional light
+// or a constant environment). power_share 1 gives every photon the same power (photon mapping's rule);
+// the even part keeps a source of little power from being starved. Which photon belongs to which
+// source changes the grid's noise, never its expectation (each source's photons carry its power / n_i).
+std::vector<size_t> photon_split(const SceneContext& ctx, const EmissionSampler* emission,
+                                 const ScatterGridSettings& s, size_t lights, size_t sources,
+                                 const Vec3& centre, double radius) {
+  constexpr int kProbes = 64;
+  std::vector<double> power(sources, 0.0);
+  double sum = 0.0;
+  for (size_t i = 0; i < sources; ++i) {
+    const bool from_media = emission && i == sources - 1;
+    const size_t source = i < lights ? i : ctx.lights.size();
+    for (int k = 0; k < kProbes; ++k) {
+      Rng rng(s.seed ^ 0x73706c6974ull, uint64_t(i) * kProbes + uint64_t(k));
+      const Photon ph = from_media ? emit_from_media(*emission, ctx.media, 1.0, rng)
+                                   : emit(ctx, source, centre, radius, 1.0, rng);
+      const double lum = luminance(ph.power);
+      if (std::isfinite(lum) && lum > 0.0) power[i] += lum / kProbes;
+    }
+    sum += power[i];
+  }
+  const double mix = sum > 0.0 ? std::clamp(s.power_share, 0.0, 1.0) : 0.0;
+  std::vector<size_t> first(sources + 1, 0);
+  for (size_t i = 0; i < sources; ++i) {
+    const double share = (sum > 0.0 ? mix * power[i] / sum : 0.0) + (1.0 - mix) / double(sources);
+    first[i + 1] = first[i] + std::max<size_t>(1, size_t(std::llround(share * double(s.photons))));
+  }
+  return first;
+}
+
 }  // namespace
 
 ScatterGrid::ScatterGrid(const SceneContext& ctx, const std::vector<const PhaseSplit*>& splits,
@@ -345,8 +385,6 @@ void ScatterGrid::trace(const SceneContext& ctx, const std::vector<const PhaseSp
   const EmissionSampler emission = scatters ? EmissionSampler(ctx.media) : EmissionSampler();
   const size_t sources = lights + (ctx.has_environment ? 1 : 0) + (emission.active() ? 1 : 0);
   if (sources == 0 || s.photons <= 0) return;
-  const size_t per_source = std::max<size_t>(1, size_t(s.photons) / sources);
-  const size_t total = size_t(passes) * sources * per_source;
 
   const Bounds media_bounds = ctx.media.bounds();
   const Vec3 extent = media_bounds.hi - media_bounds.lo;
@@ -360,7 +398,7 @@ void ScatterGrid::trace(const SceneContext& ctx, const std::vector<const PhaseSp
       .grey = grey,
       .lights = lights,
       .sources = sources,
-      .per_source = per_source,
+      .first = {},
       .emission = emission.active() ? &emission : nullptr,
       .centre = (media_bounds.lo + media_bounds.hi) * 0.5,
       .radius = 0.5 * extent.length() * (1.0 + 1e-9) + 1e-12,
@@ -368,6 +406,8 @@ void ScatterGrid::trace(const SceneContext& ctx, const std::vector<const PhaseSp
       .majorant_scale =
           s.exact_transport ? 1.0 : majorant_share(ctx.media, [&](int i) { return 1.0 - peak_fraction[i]; }),
       .blocks = {}};
+  photons.first = photon_split(ctx, photons.emission, s, lights, sources, photons.centre, photons.radius);
+  const size_t total = size_t(passes) * photons.first.back();
   const size_t nodes = grid_.size();
   size_t rgb_size = 0;
   const size_t tally_size =
