@@ -26,14 +26,15 @@ constexpr int kMaxWideScatters = 1024;  // photons are ended after this many wid
                                         // kMaxPhotonEvents real collisions)
 
 // Adds the per-node values `add` (count floats, node offset `first`) times the trilinear weights at q
-// to the tally's nodes around q. One flight's values are the same at every sample: they are computed
-// once, in float, and the node loop is a contiguous multiply-add the compiler vectorises.
-void splat(float* tally, const NodeGrid& grid, int floats_per_node, int first, int count, const Vec3& q,
-           const float* add) {
+// to the tally's nodes around q (only to the live ones, where `live` is given; see live_nodes). One
+// flight's values are the same at every sample: they are computed once, in float, and the node loop is
+// a contiguous multiply-add the compiler vectorises.
+void splat(float* tally, const NodeGrid& grid, const uint8_t* live, int floats_per_node, int first, int count,
+           const Vec3& q, const float* add) {
   const TrilinearStencil st = grid.stencil(q);
   for (int k = 0; k < 8; ++k) {
     const float wt = float(st.weight[k]);
-    if (wt <= 0.0f) continue;
+    if (wt <= 0.0f || (live && !live[st.node[k]])) continue;
     float* node = &tally[st.node[k] * floats_per_node + first];
     for (int i = 0; i < count; ++i) node[i] += wt * add[i];
   }
@@ -54,8 +55,8 @@ struct TallyBlock {
 // most kDepositStep spacings apart, each splatting its share of power x length times the harmonics of w
 // (into block.mono when given; else into the RGB block `tally`, where only the channels from the first
 // to the last with non-zero power are touched).
-void deposit_flight(float* tally, const TallyBlock& block, const NodeGrid& grid, int bands, const Vec3& x,
-                    const Vec3& w, double t_end, const Rgb& power) {
+void deposit_flight(float* tally, const TallyBlock& block, const NodeGrid& grid, const uint8_t* live,
+                    int bands, const Vec3& x, const Vec3& w, double t_end, const Rgb& power) {
   double t0, t1;
   if (!grid.bounds.intersect(x, w, 0.0, t_end, &t0, &t1)) return;
   const double len = t1 - t0;
@@ -75,7 +76,7 @@ void deposit_flight(float* tally, const TallyBlock& block, const NodeGrid& grid,
     float add[kShMaxBands * kShMaxBands];
     for (int h = 0; h < coeffs; ++h) add[h] = float(a * y[h]);
     for (int k = 0; k < n; ++k)
-      splat(block.mono, grid, coeffs, 0, coeffs, x + w * (t0 + (k + 0.5) * len / n), add);
+      splat(block.mono, grid, live, coeffs, 0, coeffs, x + w * (t0 + (k + 0.5) * len / n), add);
     return;
   }
   int c_lo = 0, c_hi = 2;
@@ -88,7 +89,7 @@ void deposit_flight(float* tally, const TallyBlock& block, const NodeGrid& grid,
     for (int h = 0; h < coeffs; ++h) add[coeffs * (c - c_lo) + h] = float(v[c] * y[h]);
   const int first = coeffs * c_lo, count = coeffs * (c_hi - c_lo + 1);
   for (int k = 0; k < n; ++k)
-    splat(tally, grid, 3 * coeffs, first, count, x + w * (t0 + (k + 0.5) * len / n), add);
+    splat(tally, grid, live, 3 * coeffs, first, count, x + w * (t0 + (k + 0.5) * len / n), add);
 }
 
 // The next pre-filtered level: the values (`floats` per node) of `fine` at its nodes 2j, filtered with
@@ -194,6 +195,7 @@ struct ScatterPhotons {
   const std::vector<double>& peak_fraction;
   const ScatterGridSettings& s;
   const NodeGrid& grid;
+  const uint8_t* live;  // per node: 1 where a lookup in the media can read it (null: every node)
   int bands;
   bool grey;      // one pass carrying RGB power (else one pass per channel)
   size_t lights;  // light sources (then the environment, then the media's emission, if any)
@@ -248,7 +250,7 @@ void ScatterPhotons::trace(size_t j, Rng& rng, PhotonBatch& batch) const {
       },
       [&](const Vec3& x, const Vec3& w, double t_end) {
         if (order >= first_order)
-          deposit_flight(batch.tally.data(), block, grid, bands, x, w, t_end, power * weight);
+          deposit_flight(batch.tally.data(), block, grid, live, bands, x, w, t_end, power * weight);
       },
       [&](const Vec3& xc, Vec3* w) { return scatter(xc, w, c, &weight, &order, rng, batch); },
       [&](const SurfaceHit& hit, Vec3* w) { return reflect(hit, w, c, &weight, &order, rng); });
@@ -351,6 +353,37 @@ std::vector<size_t> photon_split(const SceneContext& ctx, const EmissionSampler*
   return first;
 }
 
+// Per node of `grid`: 1 where a trilinear lookup at a point of non-zero extinction can read it, i.e. a
+// corner of a cell that overlaps a cell of non-zero majorant (a conservative bound of the extinction
+// everywhere in its cell), else 0. `mfs` reads the grid only where a medium scatters, so the other
+// nodes' values are never read (unless through the pre-filtered levels); on the Disney cloud 36 % of
+// the nodes are live.
+std::vector<uint8_t> live_nodes(const NodeGrid& grid, const MajorantGrid& majorants) {
+  std::vector<uint8_t> live(grid.size(), 0);
+  const auto r = majorants.resolution();
+  const Bounds b = majorants.bounds();
+  if (b.empty()) return live;
+  const Vec3 cell = (b.hi - b.lo) / Vec3(r[0], r[1], r[2]);
+  for (int z = 0; z < r[2]; ++z)
+    for (int y = 0; y < r[1]; ++y)
+      for (int x = 0; x < r[0]; ++x) {
+        if (!(majorants.cell_majorant(x, y, z) > 0.0)) continue;
+        const Vec3 lo = b.lo + Vec3(x, y, z) * cell, hi = lo + cell;
+        int i0[3], i1[3];  // the node cells it overlaps (widened by 1e-6 of a spacing against rounding)
+        for (int a = 0; a < 3; ++a) {
+          const double s0 = (lo[a] - grid.bounds.lo[a]) / grid.spacing[a] - 1e-6;
+          const double s1 = (hi[a] - grid.bounds.lo[a]) / grid.spacing[a] + 1e-6;
+          i0[a] = std::clamp(int(std::floor(s0)), 0, grid.nodes[a] - 2);
+          i1[a] = std::clamp(int(std::floor(s1)), 0, grid.nodes[a] - 2);
+        }
+        for (int k = i0[2]; k <= i1[2]; ++k)
+          for (int j = i0[1]; j <= i1[1]; ++j)
+            for (int i = i0[0]; i <= i1[0]; ++i)
+              for (int c = 0; c < 8; ++c) live[grid.index(i + (c & 1), j + (c >> 1 & 1), k + (c >> 2))] = 1;
+      }
+  return live;
+}
+
 }  // namespace
 
 ScatterGrid::ScatterGrid(const SceneContext& ctx, const std::vector<const PhaseSplit*>& splits,
@@ -394,6 +427,7 @@ void ScatterGrid::trace(const SceneContext& ctx, const std::vector<const PhaseSp
       .peak_fraction = peak_fraction,
       .s = s,
       .grid = grid_,
+      .live = nullptr,
       .bands = bands_,
       .grey = grey,
       .lights = lights,
@@ -409,6 +443,10 @@ void ScatterGrid::trace(const SceneContext& ctx, const std::vector<const PhaseSp
   photons.first = photon_split(ctx, photons.emission, s, lights, sources, photons.centre, photons.radius);
   const size_t total = size_t(passes) * photons.first.back();
   const size_t nodes = grid_.size();
+  const std::vector<uint8_t> live = s.live_nodes_only
+                                        ? live_nodes(grid_, s.majorants ? *s.majorants : ctx.majorants)
+                                        : std::vector<uint8_t>();
+  photons.live = live.empty() ? nullptr : live.data();
   size_t rgb_size = 0;
   const size_t tally_size =
       assign_blocks(ctx, grey, lights, sources, nodes, coeffs_, &photons.blocks, &rgb_size);

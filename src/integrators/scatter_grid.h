@@ -49,6 +49,11 @@ struct ScatterGridSettings {
   bool exact_transport = true;  // photons in the true medium (every collision; scatters classified peak
                                 // or wide by their share) or (false) in the similarity medium
   int bands = 3;                // spherical-harmonic bands used at lookup: 2 (l <= 1) or 3 (l <= 2)
+  // Deposit only into the nodes that a lookup where the extinction is non-zero can read (corners of
+  // cells that overlap a non-zero majorant cell); the others stay 0. For `mfs` without
+  // filtered_lookups (which reads the pre-filtered levels, built from every node): the image is
+  // bit-identical and the set-up ~5 % cheaper on the Disney cloud (docs/benchmarks.md, issue 12).
+  bool live_nodes_only = false;
   uint64_t seed = 1;
   const MajorantGrid* majorants = nullptr;  // the photons' tracking majorants (null: the scene's)
 };

@@ -1,5 +1,6 @@
 // The scatter grid's split of its photons among the lights (ScatterGridSettings::power_share): it
-// changes which photons carry which light, never what the grid holds on average.
+// changes which photons carry which light, never what the grid holds on average; and its deposits
+// into the live nodes only (live_nodes_only), which change no node a lookup in the media reads.
 #include "integrators/scatter_grid.h"
 
 #include <gtest/gtest.h>
@@ -75,6 +76,55 @@ TEST(ScatterGrid, PowerShareOfOneSource) {
   const Scene scene = split_scene(false);
   const SceneContext ctx(scene);
   EXPECT_EQ(grid_sum(ctx, 0.0, 7, 2048), grid_sum(ctx, 0.8, 7, 2048));
+}
+
+// live_nodes_only: two spheres far apart, lit by a sun and a sky. The grid is the same, bit for bit,
+// wherever a medium is (the same photons, the same sums at every node a lookup there reads), and empty
+// in the gap between them, which the full grid's photons cross.
+TEST(ScatterGrid, LiveNodesOnlyKeepTheMediaBitForBit) {
+  const Scene scene = test::scene_from_json("{" + test::camera_json(8, 8, 40.0) + R"(,
+    "media": [{"shape": {"type": "sphere", "center": [-2, 0, 0], "radius": 0.6}, "sigma_s": 4.0, "sigma_a": 0.1,
+               "phase": {"type": "hg", "g": 0.8}},
+              {"shape": {"type": "sphere", "center": [2, 0, 0], "radius": 0.6}, "sigma_s": 2.0, "sigma_a": 0.1,
+               "phase": {"type": "hg", "g": 0.5}}],
+    "lights": [{"type": "directional", "direction": [-1, 0.3, 0.2], "irradiance": 3.0},
+               {"type": "environment", "radiance": 0.1}]})");
+  const SceneContext ctx(scene);
+  std::vector<std::unique_ptr<PhaseSplit>> owned;
+  std::vector<const PhaseSplit*> splits;
+  std::vector<double> f;
+  for (int i = 0; i < 2; ++i) {
+    const Phase& phase = ctx.media.phase(i);
+    owned.push_back(std::make_unique<PhaseSplit>(phase, auto_peak_fraction(phase)));
+    splits.push_back(owned.back().get());
+    f.push_back(owned.back()->f());
+  }
+  ScatterGridSettings s;
+  s.photons = 4096;
+  s.resolution = 24;
+  const ScatterGrid full(ctx, splits, f, s);
+  s.live_nodes_only = true;
+  const ScatterGrid live(ctx, splits, f, s);
+  std::array<Rgb, kShMaxBands> chi;
+  for (int l = 0; l < kShMaxBands; ++l) chi[l] = Rgb(std::pow(0.5, l));
+  Rng rng(11, 0);
+  int inside = 0, lit = 0;
+  for (int i = 0; i < 4000; ++i) {
+    const Vec3 p(6.0 * rng.uniform() - 3.0, 1.4 * rng.uniform() - 0.7, 1.4 * rng.uniform() - 0.7);
+    const Vec3 w = normalize(Vec3(rng.uniform() - 0.5, rng.uniform() - 0.5, rng.uniform() - 0.5));
+    const Rgb a = full.scattered(p, w, chi), b = live.scattered(p, w, chi);
+    if (max_component(ctx.media.sigma_t(p)) > 0.0) {
+      ++inside;
+      lit += a[0] > 0.0;
+      for (int c = 0; c < 3; ++c) ASSERT_EQ(a[c], b[c]) << p.x << " " << p.y << " " << p.z;
+    }
+  }
+  EXPECT_GT(inside, 200);
+  EXPECT_GT(lit, inside / 2);
+  const Rgb gap_full = full.scattered(Vec3(0, 0, 0), Vec3(0, 0, 1), chi),
+            gap_live = live.scattered(Vec3(0, 0, 0), Vec3(0, 0, 1), chi);
+  EXPECT_GT(gap_full[0], 0.0);
+  EXPECT_EQ(gap_live[0], 0.0);
 }
 
 }  // namespace
