@@ -175,6 +175,7 @@ MfsIntegrator::MfsIntegrator(const SceneContext& context, MfsSettings settings, 
     grid.max_wide_scatters = s_.large_angle_scatters.value_or(0);
     grid.exact_transport = s_.photon_transport == PhotonTransport::exact;
     grid.bands = s_.scatter_grid_bands;
+    grid.live_nodes_only = !s_.filtered_lookups;  // the pre-filtered levels read every node
     grid.seed = seed;
     grid.majorants = tracking;
     grid_ = std::make_unique<ScatterGrid>(ctx_, splits, f_, grid);

@@ -39,12 +39,21 @@
 namespace nimbus {
 
 struct ScatterGridSettings {
-  int photons = 1 << 18;        // per channel pass, shared among the lights
+  int photons = 1 << 18;  // per channel pass, shared among the lights (see power_share)
+  // The lights' (and the environment's, the media's emission's) shares of the photons: power_share by
+  // their power, the rest evenly. 0.8 against 0 (even) lowers the Disney cloud's photon noise variance
+  // by ~12 % (its sun has 73 % of the power; docs/benchmarks.md, issue 12).
+  double power_share = 0.8;
   int resolution = 0;           // nodes along the longest axis of the media's bounds; 0: "auto" (mfs)
   int max_wide_scatters = 0;    // K: flights after wide scatter 1 .. K-1 are kept; 0 = all orders
   bool exact_transport = true;  // photons in the true medium (every collision; scatters classified peak
                                 // or wide by their share) or (false) in the similarity medium
   int bands = 3;                // spherical-harmonic bands used at lookup: 2 (l <= 1) or 3 (l <= 2)
+  // Deposit only into the nodes that a lookup where the extinction is non-zero can read (corners of
+  // cells that overlap a non-zero majorant cell); the others stay 0. For `mfs` without
+  // filtered_lookups (which reads the pre-filtered levels, built from every node): the image is
+  // bit-identical and the set-up ~5 % cheaper on the Disney cloud (docs/benchmarks.md, issue 12).
+  bool live_nodes_only = false;
   uint64_t seed = 1;
   const MajorantGrid* majorants = nullptr;  // the photons' tracking majorants (null: the scene's)
 };

@@ -1,0 +1,131 @@
+// The scatter grid's split of its photons among the lights (ScatterGridSettings::power_share): it
+// changes which photons carry which light, never what the grid holds on average; and its deposits
+// into the live nodes only (live_nodes_only), which change no node a lookup in the media reads.
+#include "integrators/scatter_grid.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <memory>
+
+#include "support/scenes.h"
+#include "transport/phase_split.h"
+
+namespace nimbus {
+namespace {
+
+// A sphere lit by a sun and a sky (the sun ~89 % of the power towards it), or by the sun alone.
+Scene split_scene(bool sky) {
+  return test::scene_from_json("{" + test::camera_json(8, 8, 40.0) + R"(,
+    "media": [{"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1}, "sigma_s": 4.0, "sigma_a": 0.1,
+               "phase": {"type": "hg", "g": 0.8}}],
+    "lights": [{"type": "directional", "direction": [-1, 0.3, 0.2], "irradiance": 3.0})" +
+                               std::string(sky ? R"(, {"type": "environment", "radiance": 0.03})" : "") +
+                               "]}");
+}
+
+// The grid's scattered light summed over fixed points and directions (an isotropic phase function's
+// moments l <= 2, chi = 1, 0.5, 0.25) for photons split with power_share `share`, seed `seed`.
+double grid_sum(const SceneContext& ctx, double share, uint64_t seed, int photons) {
+  const Phase& phase = ctx.media.phase(0);
+  const PhaseSplit split(phase, auto_peak_fraction(phase));
+  ScatterGridSettings s;
+  s.photons = photons;
+  s.resolution = 12;
+  s.power_share = share;
+  s.seed = seed;
+  const ScatterGrid grid(ctx, {&split}, {split.f()}, s);
+  std::array<Rgb, kShMaxBands> chi;
+  for (int l = 0; l < kShMaxBands; ++l) chi[l] = Rgb(std::pow(0.5, l));
+  Rng rng(3, 0);
+  double sum = 0.0;
+  for (int i = 0; i < 64; ++i) {
+    const Vec3 p(1.4 * rng.uniform() - 0.7, 1.4 * rng.uniform() - 0.7, 1.4 * rng.uniform() - 0.7);
+    const Vec3 w = normalize(Vec3(rng.uniform() - 0.5, rng.uniform() - 0.5, rng.uniform() - 0.5));
+    sum += luminance(grid.scattered(p, w, chi));
+  }
+  return sum;
+}
+
+// Photons shared evenly (0) or by power (1) give grids of the same mean over seeds, within their
+// noise (a z-test of the difference of the means, 4 standard errors); and not the same grids.
+TEST(ScatterGrid, PowerShareKeepsTheMean) {
+  const Scene scene = split_scene(true);
+  const SceneContext ctx(scene);
+  constexpr int kSeeds = 8;
+  double mean[2] = {}, var[2] = {};
+  for (int k = 0; k < 2; ++k) {
+    double v[kSeeds];
+    for (int i = 0; i < kSeeds; ++i) v[i] = grid_sum(ctx, k == 0 ? 0.0 : 1.0, uint64_t(i + 1), 2048);
+    for (double x : v) mean[k] += x / kSeeds;
+    for (double x : v) var[k] += (x - mean[k]) * (x - mean[k]) / (kSeeds - 1);
+  }
+  const double se = std::sqrt((var[0] + var[1]) / kSeeds);
+  std::printf("even %.5f +- %.5f, by power %.5f +- %.5f\n", mean[0], std::sqrt(var[0] / kSeeds), mean[1],
+              std::sqrt(var[1] / kSeeds));
+  ASSERT_GT(mean[0], 0.0);
+  // The sun's photons carrying its power / (the even count) instead of / (its power share's count) would
+  // put the sun's part of the grid ~80 % high (0.89 / 0.5), the sky's ~80 % low.
+  EXPECT_LT(se, 0.05 * mean[0]);
+  EXPECT_NEAR(mean[1], mean[0], 4.0 * se);
+  EXPECT_NE(grid_sum(ctx, 0.0, 1, 4096), grid_sum(ctx, 1.0, 1, 4096));
+}
+
+// One source takes every photon whatever the share: the same grid.
+TEST(ScatterGrid, PowerShareOfOneSource) {
+  const Scene scene = split_scene(false);
+  const SceneContext ctx(scene);
+  EXPECT_EQ(grid_sum(ctx, 0.0, 7, 2048), grid_sum(ctx, 0.8, 7, 2048));
+}
+
+// live_nodes_only: two spheres far apart, lit by a sun and a sky. The grid is the same, bit for bit,
+// wherever a medium is (the same photons, the same sums at every node a lookup there reads), and empty
+// in the gap between them, which the full grid's photons cross.
+TEST(ScatterGrid, LiveNodesOnlyKeepTheMediaBitForBit) {
+  const Scene scene = test::scene_from_json("{" + test::camera_json(8, 8, 40.0) + R"(,
+    "media": [{"shape": {"type": "sphere", "center": [-2, 0, 0], "radius": 0.6}, "sigma_s": 4.0, "sigma_a": 0.1,
+               "phase": {"type": "hg", "g": 0.8}},
+              {"shape": {"type": "sphere", "center": [2, 0, 0], "radius": 0.6}, "sigma_s": 2.0, "sigma_a": 0.1,
+               "phase": {"type": "hg", "g": 0.5}}],
+    "lights": [{"type": "directional", "direction": [-1, 0.3, 0.2], "irradiance": 3.0},
+               {"type": "environment", "radiance": 0.1}]})");
+  const SceneContext ctx(scene);
+  std::vector<std::unique_ptr<PhaseSplit>> owned;
+  std::vector<const PhaseSplit*> splits;
+  std::vector<double> f;
+  for (int i = 0; i < 2; ++i) {
+    const Phase& phase = ctx.media.phase(i);
+    owned.push_back(std::make_unique<PhaseSplit>(phase, auto_peak_fraction(phase)));
+    splits.push_back(owned.back().get());
+    f.push_back(owned.back()->f());
+  }
+  ScatterGridSettings s;
+  s.photons = 4096;
+  s.resolution = 24;
+  const ScatterGrid full(ctx, splits, f, s);
+  s.live_nodes_only = true;
+  const ScatterGrid live(ctx, splits, f, s);
+  std::array<Rgb, kShMaxBands> chi;
+  for (int l = 0; l < kShMaxBands; ++l) chi[l] = Rgb(std::pow(0.5, l));
+  Rng rng(11, 0);
+  int inside = 0, lit = 0;
+  for (int i = 0; i < 4000; ++i) {
+    const Vec3 p(6.0 * rng.uniform() - 3.0, 1.4 * rng.uniform() - 0.7, 1.4 * rng.uniform() - 0.7);
+    const Vec3 w = normalize(Vec3(rng.uniform() - 0.5, rng.uniform() - 0.5, rng.uniform() - 0.5));
+    const Rgb a = full.scattered(p, w, chi), b = live.scattered(p, w, chi);
+    if (max_component(ctx.media.sigma_t(p)) > 0.0) {
+      ++inside;
+      lit += a[0] > 0.0;
+      for (int c = 0; c < 3; ++c) ASSERT_EQ(a[c], b[c]) << p.x << " " << p.y << " " << p.z;
+    }
+  }
+  EXPECT_GT(inside, 200);
+  EXPECT_GT(lit, inside / 2);
+  const Rgb gap_full = full.scattered(Vec3(0, 0, 0), Vec3(0, 0, 1), chi),
+            gap_live = live.scattered(Vec3(0, 0, 0), Vec3(0, 0, 1), chi);
+  EXPECT_GT(gap_full[0], 0.0);
+  EXPECT_EQ(gap_live[0], 0.0);
+}
+
+}  // namespace
+}  // namespace nimbus
