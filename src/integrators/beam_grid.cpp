@@ -2,6 +2,7 @@
 // lookup.
 #include "integrators/beam_grid.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -15,28 +16,79 @@ namespace {
 // traced x P_peak towards the camera (rgb).
 constexpr int kBaseFloats = 9, kCameraFloats = 12;
 constexpr double kR2a1 = 0.75487766624669276, kR2a2 = 0.56984029099805327;  // the R2 sequence
-constexpr double kRoulette = 0.05;
-// Deposit samples (and the loss's midpoint rule) at most this many node spacings apart: 0.5 (0.25
-// before) halves the deposits and density lookups with no change in the validation errors beyond their
-// seed-to-seed spread (docs/benchmarks.md, issue 12).
-constexpr double kDepositStep = 0.5;  // roulette below this ratio of weight to T_wide
+constexpr double kRoulette = 0.05;  // roulette below this ratio of weight to T_wide
+// Deposit samples (and the loss's midpoint rule) at most this many node spacings apart: 1 (0.5 before,
+// 0.25 before that) halves the deposits and density lookups again with no change in the validation
+// errors beyond their seed-to-seed spread (docs/benchmarks.md, issue 12: the scatter grid's step too).
+// The straight deposit beyond a photon's first peak scatter at 2 spacings moved the means of the box,
+// the r2 sphere and the backlit spheres by +1.1 to +2.4 % (its loss no longer matches the traced one's).
+constexpr double kDepositStep = 1.0;
 
-// Adds v (channel ch) with trilinear weights st to the tally: to the straight column, or to the traced
-// one and (times mu) the traced x cosine one.
+// Which columns a deposit sample goes to.
+enum class Columns { traced, straight, both };
+
+// Adds v (channel ch) with trilinear weights st to the tally: to the straight column, to the traced one
+// and (times mu) the traced x cosine one, or to all three.
 // stride: floats per node; pk: P_peak towards the camera (stride kCameraFloats only).
 void splat(float* tally, int stride, const TrilinearStencil& st, int ch, double v, double mu, double pk,
-           bool straight) {
+           Columns to) {
   for (int j = 0; j < 8; ++j)
     if (st.weight[j] > 0.0) {
       float* node = &tally[st.node[j] * stride];
-      if (straight) {
-        node[6 + ch] += float(st.weight[j] * v);
-      } else {
-        node[ch] += float(st.weight[j] * v);
-        node[3 + ch] += float(st.weight[j] * v * mu);
-        if (stride == kCameraFloats) node[9 + ch] += float(st.weight[j] * v * pk);
+      const double x = st.weight[j] * v;
+      if (to != Columns::traced) node[6 + ch] += float(x);
+      if (to != Columns::straight) {
+        node[ch] += float(x);
+        node[3 + ch] += float(x * mu);
+        if (stride == kCameraFloats) node[9 + ch] += float(x * pk);
       }
     }
+}
+
+// The cell of the node grid that holds p (clamped into the grid), as an index over the cells (x fastest).
+size_t grid_cell(const NodeGrid& g, const Vec3& p) {
+  size_t idx = 0;
+  for (int a = 2; a >= 0; --a) {
+    const double u = std::clamp((p[a] - g.bounds.lo[a]) / g.spacing[a], 0.0, double(g.nodes[a] - 2));
+    idx = idx * size_t(g.nodes[a] - 1) + size_t(std::min(int(u), g.nodes[a] - 2));
+  }
+  return idx;
+}
+
+// Per cell of the node grid: 1 where no medium has any extinction in the cell or in the 26 around it (the
+// majorant grid's cells there are all 0). A deposit sample in such a cell has no loss (its weight is
+// unchanged) and goes only to nodes no cell with a medium touches: nodes `mfs` never reads where a
+// medium scatters (a lookup at a point reads the 8 nodes of its cell), so it is skipped, and R and the
+// mean cosine stay bit for bit what they were wherever there is a medium. Outside the media (in the
+// grid's padding, empty space inside the media's bounds, the shadow behind them) the tallies are
+// incomplete; `mfs` multiplies them by sigma_s there, which is 0.
+std::vector<uint8_t> idle_cells(const NodeGrid& g, const MajorantGrid& maj) {
+  const std::array<int, 3> cells{g.nodes[0] - 1, g.nodes[1] - 1, g.nodes[2] - 1};
+  std::vector<uint8_t> idle(size_t(cells[0]) * cells[1] * cells[2], 1);
+  const std::array<int, 3> res = maj.resolution();
+  const Bounds& mb = maj.bounds();
+  if (mb.empty()) return idle;
+  Vec3 msize;
+  for (int a = 0; a < 3; ++a) msize[a] = (mb.hi[a] - mb.lo[a]) / res[a];
+  // Each majorant cell with extinction marks the node-grid cells its box (grown by one node spacing, the
+  // 26 neighbours) overlaps, and one more on each side for rounding.
+  for (int z = 0; z < res[2]; ++z)
+    for (int y = 0; y < res[1]; ++y)
+      for (int x = 0; x < res[0]; ++x) {
+        if (!(maj.cell_majorant(x, y, z) > 0.0)) continue;
+        const int m[3] = {x, y, z};
+        int lo[3], hi[3];
+        for (int a = 0; a < 3; ++a) {
+          const double c0 = (mb.lo[a] + m[a] * msize[a] - g.bounds.lo[a]) / g.spacing[a];
+          const double c1 = (mb.lo[a] + (m[a] + 1) * msize[a] - g.bounds.lo[a]) / g.spacing[a];
+          lo[a] = std::clamp(int(std::floor(c0)) - 2, 0, cells[a] - 1);
+          hi[a] = std::clamp(int(std::floor(c1)) + 2, 0, cells[a] - 1);
+        }
+        for (int k = lo[2]; k <= hi[2]; ++k)
+          for (int j = lo[1]; j <= hi[1]; ++j)
+            for (int i = lo[0]; i <= hi[0]; ++i) idle[(size_t(k) * cells[1] + j) * cells[0] + i] = 0;
+      }
+  return idle;
 }
 
 // One photon's state: the channel whose coefficients drive it, its weight and its weight at emission.
@@ -63,47 +115,100 @@ struct BeamPhotons {
   size_t per_light;
   Vec3 centre;  // of the node grid's bounding sphere, which the photons are aimed at
   double radius;
-  double majorant_scale;          // the share of the majorant that bounds the peak-scatter rate
-  const Vec3* camera;             // tally P_peak (of medium 0) towards this point, or null
-  int stride;                     // floats per node
-  const MajorantGrid* majorants;  // the photons' tracking majorants (null: the scene's)
+  double majorant_scale;             // the share of the majorant that bounds the peak-scatter rate
+  const Vec3* camera;                // tally P_peak (of medium 0) towards this point, or null
+  int stride;                        // floats per node
+  const MajorantGrid* majorants;     // the photons' tracking majorants (null: the scene's)
+  const std::vector<uint8_t>& idle;  // per cell of the node grid: see idle_cells
 
   void trace(size_t j, Rng& rng, PhotonBatch& batch) const;
-  Rgb deposit(float* tally, const Vec3& x, const Vec3& w, double t_end, Rgb weight, int c,
-              bool straight) const;
+  void sample(float* tally, const Vec3& q, const Vec3& w, double dl, Rgb* weight, int c, Columns to) const;
+  Rgb deposit(float* tally, const Vec3& x, const Vec3& w, double t_end, Rgb weight, int c) const;
+  Rgb deposit_first(float* tally, const Vec3& x, const Vec3& w, double t_end, Rgb weight, int c) const;
   bool scatter(const Vec3& xc, Vec3* w, BeamWalk& walk, Rng& rng, PhotonBatch& batch) const;
 };
 
-// Track-length deposit of the flight x + t w, t in [0, t_end] (clipped to the grid), starting with
-// `weight` (channel c only unless grey) and losing exp(-int sigma_loss) along the way (midpoint
-// rule at the deposit samples); each sample divided by the straight-line model at that point.
-// Returns the weight at t_end.
-Rgb BeamPhotons::deposit(float* tally, const Vec3& x, const Vec3& w, double t_end, Rgb weight, int c,
-                         bool straight) const {
+// One deposit sample at q (the midpoint of a step of length dl of the flight along w): the weight loses
+// exp(-sigma_loss dl) over the step and the midpoint's weight, divided by the straight-line model phi_0
+// T_wide at q, goes to the columns `to`. Channel c only unless grey.
+void BeamPhotons::sample(float* tally, const Vec3& q, const Vec3& w, double dl, Rgb* weight, int c,
+                         Columns to) const {
+  // An idle cell: no loss, and its nodes are read by no lookup that matters (idle_cells).
+  if (idle[grid_cell(grid, q)]) return;
+  const Rgb loss = reduced_sigma_t(ctx.media, q, peak_fraction);
+  // exp(-loss dl / 2) once per channel that is deposited (once in all where the channels agree: grey media
+  // with a grey weight), the same values as computing all three.
+  Rgb half;
+  if (grey && loss.x == loss.y && loss.y == loss.z) {
+    half = Rgb(std::exp(-loss.x * (0.5 * dl)));
+  } else {
+    half = Rgb(0.0);
+    for (int ch = 0; ch < 3; ++ch)
+      if (grey || ch == c) half[ch] = std::exp(-loss[ch] * (0.5 * dl));
+  }
+  const Rgb mid = *weight * half;
+  *weight = mid * half;
+  const Rgb tw = T_wide.lookup(q);
+  const double geo = point ? 1.0 / std::max(1e-300, dot(q - point->position, q - point->position)) : 1.0;
+  const bool traced = to != Columns::straight;
+  // The cosine between the travel direction and the straight one from the light.
+  const double mu = !traced ? 1.0 : point ? dot(w, normalize(q - point->position)) : dot(w, dir_w);
+  // The peak-only light's last peak scatter towards the camera (the forward-peak term's angular factor).
+  const double pk = camera && traced ? splits[0]->peak(dot(w, normalize(*camera - q))) : 0.0;
+  const TrilinearStencil st = grid.stencil(q);
+  for (int ch = 0; ch < 3; ++ch) {
+    if ((!grey && ch != c) || !(tw[ch] > 1e-30)) continue;
+    const double v = mid[ch] * dl / (tw[ch] * geo);
+    NIMBUS_DCHECK(v >= 0.0 && std::isfinite(v));
+    splat(tally, stride, st, ch, v, mu, pk, to);
+  }
+}
+
+// Track-length deposit of a traced flight x + t w, t in [0, t_end] (clipped to the grid), starting with
+// `weight` (channel c only unless grey) and losing exp(-int sigma_loss) along the way (midpoint rule at
+// the deposit samples, at most kDepositStep node spacings apart); each sample divided by the
+// straight-line model at that point. Returns the weight at t_end.
+Rgb BeamPhotons::deposit(float* tally, const Vec3& x, const Vec3& w, double t_end, Rgb weight, int c) const {
   double t0, t1;
   if (!grid.bounds.intersect(x, w, 0.0, t_end, &t0, &t1) || !(t1 - t0 > 0.0)) return weight;
   const double len = t1 - t0;
   const int n = std::max(1, int(std::ceil(len / (kDepositStep * grid.min_spacing()))));
   const double dl = len / n;
-  for (int k = 0; k < n; ++k) {
-    const Vec3 q = x + w * (t0 + (k + 0.5) * dl);
-    const Rgb loss = reduced_sigma_t(ctx.media, q, peak_fraction);
-    const Rgb mid = weight * exp(-loss * (0.5 * dl));
-    weight = mid * exp(-loss * (0.5 * dl));
-    const Rgb tw = T_wide.lookup(q);
-    const double geo = point ? 1.0 / std::max(1e-300, dot(q - point->position, q - point->position)) : 1.0;
-    // The cosine between the travel direction and the straight one from the light.
-    const double mu = straight ? 1.0 : point ? dot(w, normalize(q - point->position)) : dot(w, dir_w);
-    // The peak-only light's last peak scatter towards the camera (the forward-peak term's angular factor).
-    const double pk = camera && !straight ? splits[0]->peak(dot(w, normalize(*camera - q))) : 0.0;
-    const TrilinearStencil st = grid.stencil(q);
-    for (int ch = 0; ch < 3; ++ch) {
-      if ((!grey && ch != c) || !(tw[ch] > 1e-30)) continue;
-      const double v = mid[ch] * dl / (tw[ch] * geo);
-      NIMBUS_DCHECK(v >= 0.0 && std::isfinite(v));
-      splat(tally, stride, st, ch, v, mu, pk, straight);
-    }
-  }
+  for (int k = 0; k < n; ++k)
+    sample(tally, x + w * (t0 + (k + 0.5) * dl), w, dl, &weight, c, Columns::traced);
+  return weight;
+}
+
+// A photon's first flight (from its emission, up to its first peak scatter at t_end) together with the
+// straight deposit: the same photon undeflected through the whole grid (the model itself with the same
+// emission: a control variate; R = traced / straight cancels the emission's sampling noise and the
+// difference between the midpoint rule's loss and the shadow map). Until t_end the two are the same
+// flight, so they share the samples (one density and one shadow-map lookup for both columns), laid out
+// over the straight chord at most kDepositStep apart; the traced flight's last, partial step takes a
+// sample of its own. A photon that never scatters deposits the same samples in both columns, so R is 1
+// to rounding wherever nothing deflects the light. Beyond the first peak scatter the straight deposit
+// goes on alone on the same samples.
+// Returns the traced weight at t_end.
+Rgb BeamPhotons::deposit_first(float* tally, const Vec3& x, const Vec3& w, double t_end, Rgb weight,
+                               int c) const {
+  double t0, t1;
+  if (!grid.bounds.intersect(x, w, 0.0, std::numeric_limits<double>::infinity(), &t0, &t1) ||
+      !(t1 - t0 > 0.0))
+    return weight;
+  const double len = t1 - t0;
+  const int n = std::max(1, int(std::ceil(len / (kDepositStep * grid.min_spacing()))));
+  const double dl = len / n;
+  // Whole steps before t_end: shared.
+  int k = 0;
+  for (; k < n && t0 + (k + 1) * dl <= t_end; ++k)
+    sample(tally, x + w * (t0 + (k + 0.5) * dl), w, dl, &weight, c, Columns::both);
+  if (k == n) return weight;  // the photon left the grid unscattered
+  Rgb straight = weight;
+  // The traced flight's partial step [t0 + k dl, t_end].
+  const double ts = t0 + k * dl, part = std::min(t_end, t1) - ts;
+  if (part > 0.0) sample(tally, x + w * (ts + 0.5 * part), w, part, &weight, c, Columns::traced);
+  // The rest of the straight chord: its own samples from step k on.
+  for (; k < n; ++k) sample(tally, x + w * (t0 + (k + 0.5) * dl), w, dl, &straight, c, Columns::straight);
   return weight;
 }
 
@@ -120,9 +225,8 @@ void BeamPhotons::trace(size_t j, Rng& rng, PhotonBatch& batch) const {
     if ((grey || ch == walk.c) && strength[ch] > 0.0) walk.weight[ch] = ph.power[ch] / strength[ch];
   if (max_component(walk.weight) <= 0.0) return;
   walk.w0 = walk.weight[walk.c];
-  // The same photon undeflected: the straight-line model with the same emission (a control
-  // variate: R = traced / straight cancels the emission's sampling noise).
-  deposit(batch.tally.data(), ph.x, ph.w, std::numeric_limits<double>::infinity(), walk.weight, walk.c, true);
+  // The first flight also deposits the same photon undeflected (deposit_first).
+  bool first = true;
   // Flights end at peak scatters only (rate sum_m f_m sigma_s,m); absorption and wide scatters are the
   // continuous loss exp(-int sigma_loss) on the weight (zero variance in a uniform medium).
   const auto peak_share = [&](int i) { return peak_fraction[i]; };
@@ -133,7 +237,9 @@ void BeamPhotons::trace(size_t j, Rng& rng, PhotonBatch& batch) const {
         return scattering_shares(walk.mp, ctx.media.count(), walk.c, peak_share).sum;
       },
       [&](const Vec3& x, const Vec3& w, double t_end) {
-        walk.weight = deposit(batch.tally.data(), x, w, t_end, walk.weight, walk.c, false);
+        walk.weight = first ? deposit_first(batch.tally.data(), x, w, t_end, walk.weight, walk.c)
+                            : deposit(batch.tally.data(), x, w, t_end, walk.weight, walk.c);
+        first = false;
       },
       [&](const Vec3& xc, Vec3* w) { return scatter(xc, w, walk, rng, batch); },
       // A reflection is a wide scatter: not part of the forward-peaked beam.
@@ -179,7 +285,7 @@ bool BeamPhotons::scatter(const Vec3& xc, Vec3* w, BeamWalk& walk, Rng& rng, Pho
 BeamGrid::BeamGrid(const SceneContext& ctx, const std::vector<const PhaseSplit*>& splits,
                    const std::vector<double>& peak_fraction,
                    const std::vector<TransmittanceGrid>& reduced_maps, int photons, int resolution,
-                   uint64_t seed, const Vec3* camera, const MajorantGrid* majorants)
+                   uint64_t seed, const Vec3* camera, const MajorantGrid* majorants, bool skip_idle)
     : stride_(camera ? kCameraFloats : kBaseFloats) {
   if (camera) camera_ = *camera;
   values_.resize(ctx.lights.size());
@@ -193,6 +299,9 @@ BeamGrid::BeamGrid(const SceneContext& ctx, const std::vector<const PhaseSplit*>
   // Photons cover the whole node grid (its padding included), so every node's estimate is complete.
   const double radius = 0.5 * (grid_.bounds.hi - grid_.bounds.lo).length() * (1.0 + 1e-9) + 1e-12;
 
+  std::vector<uint8_t> idle = idle_cells(grid_, ctx.majorants);
+  if (!skip_idle) std::fill(idle.begin(), idle.end(), uint8_t(0));
+  idle_share_ = double(std::count(idle.begin(), idle.end(), uint8_t(1))) / double(idle.size());
   const double scale = majorant_share(ctx.media, [&](int i) { return peak_fraction[i]; });
   for (size_t l = 0; l < ctx.lights.size(); ++l) {
     const Light& light = ctx.lights[l];
@@ -215,7 +324,8 @@ BeamGrid::BeamGrid(const SceneContext& ctx, const std::vector<const PhaseSplit*>
                            .majorant_scale = scale,
                            .camera = camera ? &camera_ : nullptr,
                            .stride = stride_,
-                           .majorants = majorants};
+                           .majorants = majorants,
+                           .idle = idle};
     // The batches' sums divided by the node volume.
     values_[l] = trace_photons(
         total, seed ^ 0x7065616b6265616dull ^ (uint64_t(l) << 40), grid_.size() * size_t(stride_),

@@ -12,9 +12,12 @@
 // divided by the model phi_0 T_wide at the deposit point (phi_0: the unattenuated fluence, the
 // irradiance or I / r^2), and the same photon is deposited once more undeflected (the model itself, with
 // the same emission: a control variate), so R = traced / straight is 1 wherever nothing deflects the
-// light. Photons enter through a stratified disc or cone (the R2 sequence). The traced deposits also
+// light; a photon's first flight and its straight deposit share their samples up to its first peak
+// scatter. Photons enter through a stratified disc or cone (the R2 sequence). The traced deposits also
 // carry the cosine to the straight direction from the light: the beam's mean cosine, which sets the
-// angular spread `mfs` gives the peak-only light. `mfs` multiplies T_wide by R.
+// angular spread `mfs` gives the peak-only light. `mfs` multiplies T_wide by R. Deposits in cells with no
+// medium in or next to them are skipped (nothing there is read where a medium scatters), so far from
+// the media (the grid's padding, the empty space and the shadows within its bounds) R is incomplete.
 #pragma once
 
 #include <cstdint>
@@ -31,10 +34,12 @@ namespace nimbus {
 class BeamGrid {
  public:
   // reduced_maps[l]: light l's T_wide; photons: per light; resolution as ScatterGridSettings.
+  // skip_idle: no deposits in cells with no medium in them or next to them (the lookup is the same
+  // wherever there is a medium; for tests: false deposits everywhere).
   BeamGrid(const SceneContext& ctx, const std::vector<const PhaseSplit*>& splits,
            const std::vector<double>& peak_fraction, const std::vector<TransmittanceGrid>& reduced_maps,
            int photons, int resolution, uint64_t seed, const Vec3* camera = nullptr,
-           const MajorantGrid* majorants = nullptr);
+           const MajorantGrid* majorants = nullptr, bool skip_idle = true);
   // R for light `light` at p (trilinear between nodes) and the peak-only light's mean cosine to the
   // straight direction from the light; false (nothing written) outside the grid and for other lights.
   // With a camera, peak_toward (if not null) gets the traced beam's P_peak (medium 0's) towards the camera,
@@ -45,11 +50,14 @@ class BeamGrid {
   // Peak scatters whose direction the rejection sampler could not draw (the photon flew on
   // undeflected; see sample_by_rejection). 0 in every normal case.
   uint64_t rejection_failures() const { return rejection_failures_; }
+  // The share of the grid's cells whose deposits were skipped (no medium in or next to them).
+  double idle_share() const { return idle_share_; }
 
  private:
   NodeGrid grid_;                           // the media's bounds padded by one spacing (node_grid_padded)
   std::vector<std::vector<float>> values_;  // per light and node: traced, traced x cosine, straight (rgb)
   uint64_t rejection_failures_ = 0;
+  double idle_share_ = 0.0;
   int stride_;        // floats per node
   Vec3 camera_{0.0};  // the point P_peak is tallied towards (with stride_ 12)
 };

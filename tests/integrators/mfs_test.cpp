@@ -535,6 +535,62 @@ TEST(Mfs, BeamGridTalliesThePeakTowardsTheCamera) {
   std::printf("peak towards the camera, thin sphere: worst |error| / (P_peak + 0.1) %.4f\n", worst);
 }
 
+// The beam grid skips its deposits in cells with no medium in them or next to them (idle cells: the gap
+// between two spheres). Wherever there is a medium, R, the mean cosine and P_peak towards the camera must
+// be bit for bit those of the grid that deposits everywhere (a lookup reads only its cell's nodes); in the
+// gap they are not (the skip happened: there the tallies are empty, R and the cosine 1).
+TEST(Mfs, BeamGridSkipsIdleCellsWithoutChangingTheMedia) {
+  const Scene scene = test::scene_from_json("{" + test::camera_json(8, 8) + R"(,
+    "media": [{"shape": {"type": "sphere", "center": [-2, 0, 0], "radius": 0.7}, "sigma_s": 3.0, "sigma_a": 0.05,
+               "phase": {"type": "hg", "g": 0.85}},
+              {"shape": {"type": "sphere", "center": [2, 0, 0], "radius": 0.7}, "sigma_s": 3.0, "sigma_a": 0.05,
+               "phase": {"type": "hg", "g": 0.85}}],
+    "lights": [{"type": "directional", "direction": [1, -0.3, 0.2], "irradiance": 1.0},
+               {"type": "point", "position": [-3, -1.5, 0.5], "intensity": 2.0}]})");
+  const SceneContext ctx(scene);
+  MfsSettings ms = mfs_settings_from_json(nlohmann::json::object(), "test");
+  ms.large_angle_scatters = 0;
+  ms.beam_photons = 0;
+  const MfsIntegrator mfs(ctx, ms);
+  const std::vector<const PhaseSplit*> splits{&mfs.split(0), &mfs.split(1)};
+  const std::vector<double> f{mfs.split(0).f(), mfs.split(1).f()};
+  std::vector<TransmittanceGrid> maps;
+  for (const Light& light : ctx.lights) maps.emplace_back(ctx.media, ctx.majorants, light, 32, 0.25, f);
+  const Vec3 cam(0.0, -6.0, 0.0);
+  const BeamGrid skip(ctx, splits, f, maps, 4096, 40, 7, &cam, nullptr, true);
+  const BeamGrid all(ctx, splits, f, maps, 4096, 40, 7, &cam, nullptr, false);
+  std::printf("beam grid: idle share of the cells %.3f\n", skip.idle_share());
+  EXPECT_GT(skip.idle_share(), 0.2);
+  EXPECT_EQ(all.idle_share(), 0.0);
+  Rng rng(11, 0);
+  int inside = 0, gap = 0, gap_differs = 0;
+  for (int i = 0; i < 3000; ++i) {
+    const double x = 5.4 * rng.uniform() - 2.7, y = 1.4 * rng.uniform() - 0.7, z = 1.4 * rng.uniform() - 0.7;
+    const Vec3 p(x, y, z);
+    const bool in_media = (p - Vec3(-2, 0, 0)).length() < 0.7 || (p - Vec3(2, 0, 0)).length() < 0.7;
+    const bool in_gap = std::abs(x) < 0.5;
+    for (size_t l = 0; l < 2; ++l) {
+      Rgb R[2], mc[2], pk[2];
+      ASSERT_TRUE(skip.lookup(l, p, &R[0], &mc[0], &pk[0]));
+      ASSERT_TRUE(all.lookup(l, p, &R[1], &mc[1], &pk[1]));
+      for (int c = 0; c < 3; ++c) {
+        if (in_media) {
+          EXPECT_EQ(R[0][c], R[1][c]) << "light " << l << " at " << x << " " << y << " " << z;
+          EXPECT_EQ(mc[0][c], mc[1][c]) << "light " << l << " at " << x << " " << y << " " << z;
+          EXPECT_EQ(pk[0][c], pk[1][c]) << "light " << l << " at " << x << " " << y << " " << z;
+        }
+      }
+      if (in_gap) gap_differs += R[0][0] != R[1][0] || mc[0][0] != mc[1][0];
+      inside += in_media;
+      gap += in_gap;
+    }
+  }
+  std::printf("beam grid: %d lookups in the media the same, %d of %d in the gap differ\n", inside,
+              gap_differs, gap);
+  EXPECT_GT(inside, 300);
+  EXPECT_GT(gap_differs, gap / 2);
+}
+
 // Steps that grow with the camera-side depth (the default) give the image of fixed steps: the light
 // from deep in is attenuated and blurred, and the jittered march stays unbiased.
 TEST(Mfs, GrowingStepsMatchFixedSteps) {
