@@ -12,6 +12,7 @@
 #include <cstring>
 #include <vector>
 
+#include "core/zeroed_floats.h"
 #include "nimbus/error.h"
 
 namespace nimbus {
@@ -19,7 +20,7 @@ namespace nimbus {
 struct DensityGrid::Data {
   nanovdb::GridHandle<nanovdb::HostBuffer> handle;
   std::vector<float> bricks;
-  std::vector<float> dense;  // the dense copy of the voxels (empty: none)
+  ZeroedFloats dense;  // the dense copy of the voxels (empty: none; huge pages, for the TLB: issue 12)
   DensityGrid::Stats stats;
 };
 
@@ -231,9 +232,9 @@ ValueCounts build_brick_max(const nanovdb::FloatGrid& grid, const std::array<int
 // a leaf's values are copied from its array; a block without a leaf holds one tile or background value.
 // Parallel over x slabs of 8.
 void build_dense(const nanovdb::FloatGrid& grid, const std::array<int, 3>& lo, const std::array<int, 3>& n,
-                 std::vector<float>& dense) {
+                 ZeroedFloats& dense) {
   const int64_t sy = n[2], sx = static_cast<int64_t>(n[1]) * n[2];
-  dense.resize(static_cast<size_t>(sx) * n[0]);
+  dense = ZeroedFloats(static_cast<size_t>(sx) * n[0]);
   const int x_end = lo[0] + n[0], y_end = lo[1] + n[1], z_end = lo[2] + n[2];
   const int ox0 = lo[0] & ~7, slabs = ((x_end - 1 - ox0) >> 3) + 1;
   tbb::parallel_for(tbb::blocked_range<int>(0, slabs), [&](const tbb::blocked_range<int>& r) {
