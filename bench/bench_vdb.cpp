@@ -1,5 +1,6 @@
 // Volume grid micro-benchmarks: load time of the shared test volumes, and the cost of a density
-// lookup through DensityGrid::density_index (accessor per call) versus a per-thread Sampler.
+// lookup through DensityGrid::density_index (a per-thread cached accessor, or the dense copy of a small
+// grid) versus a per-thread Sampler, and the same through the tree alone (DensityGrid::without_dense).
 #include <benchmark/benchmark.h>
 
 #include <filesystem>
@@ -64,6 +65,43 @@ void BM_SamplerDensity(benchmark::State& state) {
   state.SetLabel(kFiles[state.range(0)]);
 }
 BENCHMARK(BM_SamplerDensity)->Arg(0)->Arg(1);
+
+// The same lookups through the tree, as without the dense copy (the cloud has one; the smoke too).
+void BM_TreeDensityIndex(benchmark::State& state) {
+  const DensityGrid loaded = load_density_grid(volume(kFiles[state.range(0)]));
+  const DensityGrid g = loaded.without_dense();
+  const auto pts = ray_points(g, 1 << 16);
+  size_t i = 0;
+  for (auto _ : state) benchmark::DoNotOptimize(g.density_index(pts[i++ & 0xffff]));
+  state.SetLabel(kFiles[state.range(0)]);
+}
+BENCHMARK(BM_TreeDensityIndex)->Arg(0)->Arg(1);
+
+void BM_TreeSamplerDensity(benchmark::State& state) {
+  const DensityGrid loaded = load_density_grid(volume(kFiles[state.range(0)]));
+  const DensityGrid g = loaded.without_dense();
+  const auto pts = ray_points(g, 1 << 16);
+  DensityGrid::Sampler s(g);
+  size_t i = 0;
+  for (auto _ : state) benchmark::DoNotOptimize(s.density_index(pts[i++ & 0xffff]));
+  state.SetLabel(kFiles[state.range(0)]);
+}
+BENCHMARK(BM_TreeSamplerDensity)->Arg(0)->Arg(1);
+
+// Incoherent lookups (independent uniform points in the bbox), dense copy against the tree.
+void BM_RandomDensityIndex(benchmark::State& state) {
+  const DensityGrid loaded = load_density_grid(volume(kFiles[0]));
+  const DensityGrid g = state.range(0) ? loaded : loaded.without_dense();
+  std::mt19937_64 rng(8);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<Vec3> pts(1 << 16);
+  const Vec3 lo = g.index_lo(), ext = g.index_hi() - g.index_lo();
+  for (auto& p : pts) p = Vec3(lo.x + u(rng) * ext.x, lo.y + u(rng) * ext.y, lo.z + u(rng) * ext.z);
+  size_t i = 0;
+  for (auto _ : state) benchmark::DoNotOptimize(g.density_index(pts[i++ & 0xffff]));
+  state.SetLabel(state.range(0) ? "dense" : "tree");
+}
+BENCHMARK(BM_RandomDensityIndex)->Arg(0)->Arg(1);
 
 void BM_MaxDensityIndex(benchmark::State& state) {
   const DensityGrid g = load_density_grid(volume(kFiles[0]));

@@ -12,6 +12,7 @@
 #include <cstring>
 #include <vector>
 
+#include "core/zeroed_floats.h"
 #include "nimbus/error.h"
 
 namespace nimbus {
@@ -19,6 +20,7 @@ namespace nimbus {
 struct DensityGrid::Data {
   nanovdb::GridHandle<nanovdb::HostBuffer> handle;
   std::vector<float> bricks;
+  ZeroedFloats dense;  // the dense copy of the voxels (empty: none; huge pages, for the TLB: issue 12)
   DensityGrid::Stats stats;
 };
 
@@ -223,6 +225,44 @@ ValueCounts build_brick_max(const nanovdb::FloatGrid& grid, const std::array<int
   return total;
 }
 
+// ---- dense copy ---------------------------------------------------------------------------------
+
+// Copies the voxels lo ... lo + n - 1 (per axis) into dense (z fastest, then y, then x), negative values
+// as 0 (the same std::max(0.0f, v) as the tree sampler). One leaf-sized block (8^3, aligned) at a time:
+// a leaf's values are copied from its array; a block without a leaf holds one tile or background value.
+// Parallel over x slabs of 8.
+void build_dense(const nanovdb::FloatGrid& grid, const std::array<int, 3>& lo, const std::array<int, 3>& n,
+                 ZeroedFloats& dense) {
+  const int64_t sy = n[2], sx = static_cast<int64_t>(n[1]) * n[2];
+  dense = ZeroedFloats(static_cast<size_t>(sx) * n[0]);
+  const int x_end = lo[0] + n[0], y_end = lo[1] + n[1], z_end = lo[2] + n[2];
+  const int ox0 = lo[0] & ~7, slabs = ((x_end - 1 - ox0) >> 3) + 1;
+  tbb::parallel_for(tbb::blocked_range<int>(0, slabs), [&](const tbb::blocked_range<int>& r) {
+    auto acc = grid.getAccessor();
+    for (int slab = r.begin(); slab < r.end(); ++slab) {
+      const int ox = ox0 + 8 * slab;
+      for (int oy = lo[1] & ~7; oy < y_end; oy += 8)
+        for (int oz = lo[2] & ~7; oz < z_end; oz += 8) {
+          const int x0 = std::max(ox, lo[0]), x1 = std::min(ox + 8, x_end);
+          const int y0 = std::max(oy, lo[1]), y1 = std::min(oy + 8, y_end);
+          const int z0 = std::max(oz, lo[2]), z1 = std::min(oz + 8, z_end);
+          const auto* leaf = acc.probeLeaf(Coord(ox, oy, oz));
+          const float tile = leaf == nullptr ? std::max(0.0f, acc.getValue(Coord(ox, oy, oz))) : 0.0f;
+          for (int x = x0; x < x1; ++x)
+            for (int y = y0; y < y1; ++y) {
+              float* out = dense.data() + (x - lo[0]) * sx + (y - lo[1]) * sy - lo[2];
+              if (leaf == nullptr) {
+                std::fill(out + z0, out + z1, tile);
+                continue;
+              }
+              const float* in = leaf->data()->mValues + (((x & 7) << 6) | ((y & 7) << 3));
+              for (int z = z0; z < z1; ++z) out[z] = std::max(0.0f, in[z & 7]);
+            }
+        }
+    }
+  });
+}
+
 void check_finite(const std::string& source, const nanovdb::FloatGrid& grid, const ValueCounts& counts) {
   if (counts.bad == 0) return;
   const Coord& c = counts.first_bad;
@@ -264,7 +304,8 @@ GridSummary summarize_float_grid(const nanovdb::FloatGrid& grid) {
 // ---- DensityGrid ----------------------------------------------------------------------------------
 
 DensityGrid DensityGrid::from_nanovdb(nanovdb::GridHandle<nanovdb::HostBuffer> handle,
-                                      const std::string& source, double read_seconds, double check_seconds) {
+                                      const std::string& source, double read_seconds, double check_seconds,
+                                      uint64_t dense_max_bytes) {
   const auto t1 = std::chrono::steady_clock::now();
   auto data = std::make_shared<Data>();
   data->handle = std::move(handle);
@@ -287,6 +328,17 @@ DensityGrid DensityGrid::from_nanovdb(nanovdb::GridHandle<nanovdb::HostBuffer> h
   const ValueCounts counts = build_brick_max(*grid, g.lo_i_, hi_i, g.brick_n_, data->bricks);
   check_finite(source, *grid, counts);
 
+  // The dense copy: voxels lo_i ... hi_i + 1 per axis (what trilinear reads), if they fit the cap.
+  std::array<int, 3> dense_n;
+  double dense_bytes = sizeof(float);
+  for (int a = 0; a < 3; ++a) dense_n[a] = hi_i[a] + 2 - g.lo_i_[a], dense_bytes *= dense_n[a];
+  if (dense_bytes <= static_cast<double>(dense_max_bytes)) {
+    build_dense(*grid, g.lo_i_, dense_n, data->dense);
+    g.dense_ = data->dense.data();
+    g.dense_sy_ = dense_n[2];
+    g.dense_sx_ = static_cast<int64_t>(dense_n[1]) * dense_n[2];
+  }
+
   Stats& st = data->stats;
   st.name = w.name;
   st.file = source;
@@ -298,6 +350,7 @@ DensityGrid DensityGrid::from_nanovdb(nanovdb::GridHandle<nanovdb::HostBuffer> h
   st.max_value = w.max;
   st.mean_active = w.sum / static_cast<double>(w.active_voxels);
   st.negative_count = counts.negative;
+  st.dense_bytes = data->dense.size() * sizeof(float);
   st.read_seconds = read_seconds;
   st.analyse_seconds =
       check_seconds + std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();

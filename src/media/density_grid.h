@@ -2,6 +2,10 @@
 // interpolation in index space, with a coarse "brick max" array for cheap conservative majorants, its
 // statistics and its index <-> world maps. Reading volume files (OpenVDB, .nvdb) is io/vdb.h's.
 //
+// A grid whose data bbox is small also keeps a dense copy of the voxels the sampler can read (see
+// kDenseMaxBytes): its lookups read that array instead of descending the tree, with the same values and
+// the same arithmetic, so the density is bit for bit the same (issue 12).
+//
 // Conventions (NanoVDB/OpenVDB): the value of voxel ijk sits at the index-space point (i, j, k);
 // index <-> world is the grid's own affine map. Negative voxel values are clamped to 0 before
 // interpolation (their count is reported in stats().negative_count); NaN/inf values anywhere the
@@ -46,17 +50,20 @@ class DensityGrid {
     std::array<int, 3> index_min{}, index_max{};           // active index bbox (inclusive voxel coordinates)
     double min_value = 0, max_value = 0, mean_active = 0;  // over the active values (raw, unclamped)
     uint64_t negative_count = 0;  // voxels with a negative value that sampling can read (clamped to 0)
+    uint64_t dense_bytes = 0;     // bytes of the dense copy of the voxels (0: none; see kDenseMaxBytes)
     double read_seconds = 0;      // wall time to read (and for .vdb convert) the grid
     double analyse_seconds = 0;   // wall time of the checks, statistics and brick max build
   };
 
   // A per-thread sampler: holds a NanoVDB ReadAccessor (which caches the last nodes visited and is
-  // not thread-safe). Cheap to create; faster than DensityGrid::density_index when one thread makes
-  // many lookups (see bench/bench_vdb.cpp). The grid must outlive it.
+  // not thread-safe) for a grid without a dense copy; with one it reads the copy, as density_index does.
+  // Cheap to create (see bench/bench_vdb.cpp). The grid must outlive it.
   class Sampler {
    public:
     explicit Sampler(const DensityGrid& grid) : grid_(&grid), acc_(grid.grid_->getAccessor()) {}
-    double density_index(const Vec3& index_pos) { return grid_->trilinear(acc_, index_pos); }
+    double density_index(const Vec3& index_pos) {
+      return grid_->dense_ != nullptr ? grid_->trilinear_dense(index_pos) : grid_->trilinear(acc_, index_pos);
+    }
 
    private:
     const DensityGrid* grid_;
@@ -68,19 +75,29 @@ class DensityGrid {
   // values (no empty grid, a bbox of at most 2^31 voxels, no NaN/inf the sampler can read) and builds
   // the brick max. `source` names the grid in errors ("<source>: <what>"). read_seconds and
   // check_seconds are the caller's time to read and check it, kept in stats().
+  //
+  // The dense copy: when the voxels the sampler can read (the data bbox [index_lo, index_hi] plus one
+  // voxel above, per axis) take at most kDenseMaxBytes as floats, they are copied into one array (z
+  // fastest, as in a NanoVDB leaf; negative values stored as 0) and every lookup reads it. The cap, 64 MiB
+  // (16.8 M voxels), is about what the photon grids of `mfs` take: the Disney cloud at 1/16 takes 7.2 MB
+  // (4.3 voxels per active voxel), the same upsampled 2x per axis 53 MB; 4x (418 MB) reads the tree.
+  // A lookup costs 0.25-0.4 of the tree's (docs/benchmarks.md, "A dense copy of small grids").
+  static constexpr uint64_t kDenseMaxBytes = uint64_t(64) << 20;
   static DensityGrid from_nanovdb(nanovdb::GridHandle<nanovdb::HostBuffer> handle, const std::string& source,
-                                  double read_seconds = 0.0, double check_seconds = 0.0);
+                                  double read_seconds = 0.0, double check_seconds = 0.0,
+                                  uint64_t dense_max_bytes = kDenseMaxBytes);
 
   // Index space <-> the grid's world space (the file's own transform).
   Vec3 world_to_index(const Vec3& grid_world) const;
   Vec3 index_to_world(const Vec3& index) const;
 
   // Trilinear density at an index-space position (negative voxels clamped to 0); 0 outside
-  // [index_lo(), index_hi()]. Thread-safe: each thread keeps one accessor for the grid it read last
+  // [index_lo(), index_hi()]. Reads the dense copy when there is one. Otherwise thread-safe: each thread keeps one accessor for the grid it read last
   // (keyed by the grid's process-unique id, not its address), so lookups near the previous one skip the
   // descent from the root (the photons' tracking and the shadow maps' marches: issue 12). The values
   // are the same as with a fresh accessor.
   double density_index(const Vec3& index_pos) const {
+    if (dense_ != nullptr) return trilinear_dense(index_pos);
     struct Cache {
       uint64_t id = 0;
       std::optional<nanovdb::DefaultReadAccessor<float>> acc;
@@ -112,6 +129,15 @@ class DensityGrid {
   Bounds world_bounds() const;
 
   const Stats& stats() const;
+  // Whether lookups read a dense copy of the voxels (see kDenseMaxBytes).
+  bool has_dense() const { return dense_ != nullptr; }
+  // A copy of this grid (sharing its data) whose lookups read the tree, as if it had no dense copy: the
+  // reference for tests and benchmarks of the dense path. stats() still counts the dense copy's bytes.
+  DensityGrid without_dense() const {
+    DensityGrid g = *this;
+    g.dense_ = nullptr;
+    return g;
+  }
   // The NanoVDB grid itself (for HDDA, tests and GPU upload). Valid while this object (or a copy) lives.
   const nanovdb::FloatGrid& nano_grid() const { return *grid_; }
 
@@ -127,6 +153,18 @@ class DensityGrid {
  private:
   template <typename Acc>
   double trilinear(Acc& acc, const Vec3& p) const;
+  double trilinear_dense(const Vec3& p) const;
+  // The interpolation of the 8 corner values c[dx][dy][dz] (already clamped) at offsets u, v, w: one
+  // arithmetic for the tree and the dense copy, so their results are the same bits.
+  static double interpolate(const double c[2][2][2], double u, double v, double w) {
+    const double c00 = c[0][0][0] + (c[1][0][0] - c[0][0][0]) * u;
+    const double c01 = c[0][0][1] + (c[1][0][1] - c[0][0][1]) * u;
+    const double c10 = c[0][1][0] + (c[1][1][0] - c[0][1][0]) * u;
+    const double c11 = c[0][1][1] + (c[1][1][1] - c[0][1][1]) * u;
+    const double c0 = c00 + (c10 - c00) * v;
+    const double c1 = c01 + (c11 - c01) * v;
+    return c0 + (c1 - c0) * w;
+  }
 
   std::shared_ptr<const Data> data_;
   const nanovdb::FloatGrid* grid_ = nullptr;
@@ -135,6 +173,10 @@ class DensityGrid {
   std::array<int, 3> lo_i_{};  // integer index_lo
   Vec3 lo_{0.0}, hi_{0.0};
   double max_density_ = 0.0;
+  // The dense copy (null when none): voxel (i, j, k) at ((i - lo_i_[0]) * dense_sx_ + (j - lo_i_[1]) *
+  // dense_sy_ + (k - lo_i_[2])), for i ... index_hi + 1 per axis.
+  const float* dense_ = nullptr;
+  int64_t dense_sx_ = 0, dense_sy_ = 0;
   uint64_t id_ = 0;  // unique per grid built in this process (copies share it): density_index's cache key
 };
 
@@ -163,13 +205,22 @@ inline double DensityGrid::trilinear(Acc& acc, const Vec3& p) const {
         for (int dz = 0; dz < 2; ++dz)
           c[dx][dy][dz] = std::max(0.0f, acc.getValue(nanovdb::Coord(ijk[0] + dx, ijk[1] + dy, ijk[2] + dz)));
   }
-  const double c00 = c[0][0][0] + (c[1][0][0] - c[0][0][0]) * u;
-  const double c01 = c[0][0][1] + (c[1][0][1] - c[0][0][1]) * u;
-  const double c10 = c[0][1][0] + (c[1][1][0] - c[0][1][0]) * u;
-  const double c11 = c[0][1][1] + (c[1][1][1] - c[0][1][1]) * u;
-  const double c0 = c00 + (c10 - c00) * v;
-  const double c1 = c01 + (c11 - c01) * v;
-  return c0 + (c1 - c0) * w;
+  return interpolate(c, u, v, w);
+}
+
+inline double DensityGrid::trilinear_dense(const Vec3& p) const {
+  if (!(p.x >= lo_.x && p.y >= lo_.y && p.z >= lo_.z && p.x <= hi_.x && p.y <= hi_.y && p.z <= hi_.z))
+    return 0.0;  // also rejects NaN positions
+  const double fx = std::floor(p.x), fy = std::floor(p.y), fz = std::floor(p.z);
+  const double u = p.x - fx, v = p.y - fy, w = p.z - fz;
+  const float* d =
+      dense_ + ((static_cast<int64_t>(fx) - lo_i_[0]) * dense_sx_ +
+                (static_cast<int64_t>(fy) - lo_i_[1]) * dense_sy_ + (static_cast<int64_t>(fz) - lo_i_[2]));
+  double c[2][2][2];
+  for (int dx = 0; dx < 2; ++dx)
+    for (int dy = 0; dy < 2; ++dy)
+      for (int dz = 0; dz < 2; ++dz) c[dx][dy][dz] = d[dx * dense_sx_ + dy * dense_sy_ + dz];
+  return interpolate(c, u, v, w);
 }
 
 }  // namespace nimbus
