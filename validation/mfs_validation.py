@@ -175,6 +175,8 @@ def uniform_fit(runs, noise):
 def adaptive_fit(runs, noise, t0):
     """Adaptive path tracing: rel RMSE^2 = A / (time - t0) + noise^2 (t0: uniform path tracing's fixed cost), A
     from the run with the smallest error. Returns A, or None when no run is above the reference's noise."""
+    if not runs:
+        return None
     best = min(runs, key=lambda r: r["rel_rmse"])
     e2 = best["rel_rmse"] ** 2 - noise ** 2
     return None if e2 <= 0 else {key: e2 * max(best[key] - t0[key], 1e-9) for key in ("cpu_s", "time_s")}
@@ -282,7 +284,10 @@ def main():
     ap.add_argument("--orders", action="store_true", help="only the order-by-order comparison")
     ap.add_argument("--options", action="store_true", help="only every mfs option at 4 spp (48 x 48)")
     ap.add_argument("--tables", action="store_true", help="only rewrite tables and plots from the results")
-    ap.add_argument("--size-study", action="store_true", help="only the 512 x 512 Disney cloud frontier")
+    ap.add_argument("--size-study", action="store_true", help="only the 512 x 512 Disney cloud bound (old)")
+    ap.add_argument("--size-frontier", metavar="SCENES",
+                    help="the 512 x 512 frontier of these scenes (comma-separated): reference, mfs 1 and 4 spp, "
+                         "pathtrace 4, 16, 64 spp; writes render_512_results.json and the 512 x 512 section")
     ap.add_argument("--res", type=int, default=128, help="image size of the suite (res x res)")
     ap.add_argument("--results", help="results file (default docs/validation/render_results.json)")
     ap.add_argument("--mfs-spp", default=",".join(map(str, MFS_SPP)), help="the mfs frontier's spp, e.g. 1,4,16")
@@ -294,6 +299,8 @@ def main():
     os.makedirs(IMG, exist_ok=True)
     if args.size_study:
         return size_study()
+    if args.size_frontier:
+        return size_frontier(args.size_frontier.split(","), args.ref_spp or {})
     if args.orders:
         return orders()
     if args.options:
@@ -302,7 +309,8 @@ def main():
     results = json.load(open(results_path)) if os.path.exists(results_path) else {}
     results = {k: v for k, v in results.items() if "mfs" in v}  # frontier entries only
     if args.tables:
-        size_text(results.get("disney_cloud"))
+        if not size_frontier_text():
+            size_text(results.get("disney_cloud"))
         write_table(results)
         return plots(results)
     scenes = suite()
@@ -421,6 +429,47 @@ def size_study():
         out[f"{label}_512_{spp}spp"] = {"time_s": t, "cpu_s": LAST_CPU[0]}
         print(f"512 x 512 {label} {spp} spp: wall {t:.1f} s, CPU {LAST_CPU[0]:.1f} s", flush=True)
     json.dump(out, open(os.path.join(DOCS, "render_size_study.json"), "w"), indent=1, sort_keys=True)
+
+
+SIZE_RESULTS = os.path.join(DOCS, "render_512_results.json")
+REF_SPP_512 = {"disney_cloud": 512, "sphere_r10_a0.99_hg0.85_front": 2048, "sphere_r2_a0.99_hg0.85_side": 2048}
+
+
+def size_frontier(names, ref_spp):
+    """The frontier at 512 x 512 of the scenes `names`: a converged reference (REF_SPP_512 or --ref-spp), `mfs` at
+    1 and 4 spp and `pathtrace` at 4, 16 and 64 spp (uniform; adaptive and octave are not run at this size), all
+    back to back; the same fits as at 128 x 128. Writes render_512_results.json and the size512 section."""
+    results = json.load(open(SIZE_RESULTS)) if os.path.exists(SIZE_RESULTS) else {}
+    scenes = suite()
+    for name in names:
+        scene, base, _ = scenes[name]
+        sc = sized(scene, 512, 512)
+        spp = int(ref_spp.get(name, REF_SPP_512.get(name, 2048)))
+        r = frontier(f"{name}_512x512", sc, base, spp, mfs_spp=[1, 4], octave_spp=[], pt_spp=[4, 16, 64],
+                     pt_noise=[])
+        r["commit"], r["machine"] = commit_id(), machine_state()
+        results[name] = r
+        json.dump(results, open(SIZE_RESULTS, "w"), indent=1, sort_keys=True)
+    size_frontier_text()
+
+
+def size_frontier_text():
+    """The 512 x 512 section (between <!-- size512 --> markers) from render_512_results.json; False if none."""
+    if not os.path.exists(SIZE_RESULTS):
+        return False
+    res = json.load(open(SIZE_RESULTS))
+    res = {n: res[n] for n in suite() if n in res}
+    loads = [r["machine"]["load_average"][0] for r in res.values()]
+    dates = sorted(r["machine"]["date"] for r in res.values())
+    commits = "; ".join(f"{n}: {r['commit']}" for n, r in res.items())
+    head = [f"512 x 512, {dates[0]} to {dates[-1]}; load average {min(loads):.1f} to {max(loads):.1f} on 2 cores "
+            f"while measured. Commits: {commits}. `pathtrace` uniform at 4, 16 and 64 spp (adaptive sampling and "
+            f"`octave` not run at this size), 4 x 4-pixel bins as at 128 x 128.", ""]
+    text = "\n".join(head + speed_rows(res) + ["", "The frontiers (rel RMSE @ CPU seconds):", ""] +
+                     frontier_rows(res))
+    print(text)
+    write_between_markers("size512", text)
+    return True
 
 
 def size_text(cloud128):
