@@ -49,4 +49,10 @@ inline void sh_eval(const Vec3& w, int bands, double* y) {
   }
 }
 
+// Y_lm(w), l < bands, kept for a direction that many lookups share (a camera ray's -d along its march).
+struct ShBasis {
+  double y[kShMaxBands * kShMaxBands];
+  ShBasis(const Vec3& w, int bands) { sh_eval(w, bands, y); }
+};
+
 }  // namespace nimbus

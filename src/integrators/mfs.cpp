@@ -210,6 +210,7 @@ Rgb MfsIntegrator::trace(const Ray& ray, Rng& rng, CameraSample* sample, int bou
   MediumPoint mp;
   const bool blur = s_.source_blur && !s_.light_side();  // forward_side "light" has no camera-side spread
   MarchRecorder layers(sample);  // direct: the lights' light that took at most one wide scatter
+  const ShBasis y_out(-d, grid_ ? grid_->bands() : 1);  // the scatter grid's basis towards the camera
   Rgb direct(0.0);
   march_growing(
       ctx_.majorants, o, d, hit.t, s_.tau_step, jitter,
@@ -229,8 +230,8 @@ Rgb MfsIntegrator::trace(const Ray& ray, Rng& rng, CameraSample* sample, int bou
         if (max_component(mp.sigma_s) > 0.0) {
           const CameraPoint y = cam.at(k, jitter, dt, s_.light_side(), s_.path_lengthening);
           Sources src;  // via y.T_cam / y.T_full
-          add_sources(mp, p, d, t, y, cam, rng, !blur, true, &src);
-          if (blur) add_blurred_sources(p, d, t, y, cam, rng, &src);
+          add_sources(mp, p, d, y_out, t, y, cam, rng, !blur, true, &src);
+          if (blur) add_blurred_sources(p, d, y_out, t, y, cam, rng, &src);
           L_step = (y.T_cam * src.in_scatter + y.T_full * src.peak_scatter) * dt;
           L += L_step;
           direct += (y.T_cam * src.lights_scatter + y.T_full * src.peak_scatter) * dt;
@@ -259,30 +260,32 @@ Rgb MfsIntegrator::trace(const Ray& ray, Rng& rng, CameraSample* sample, int bou
   return L + L_end;
 }
 
-void MfsIntegrator::add_blurred_sources(const Vec3& p, const Vec3& d, double t, const CameraPoint& y,
-                                        const CameraPath& cam, Rng& rng, Sources* out) const {
+void MfsIntegrator::add_blurred_sources(const Vec3& p, const Vec3& d, const ShBasis& y_out, double t,
+                                        const CameraPoint& y, const CameraPath& cam, Rng& rng,
+                                        Sources* out) const {
   // T_cam's light left its last scatter in the lateral footprint of depth t (eq. D14): the source there,
   // zero outside the media.
   const double u1 = rng.uniform(), u2 = rng.uniform();  // in this order (argument order is unspecified)
   const Vec3 ps = p + lateral_offset(d, cam.lateral_spread(t), u1, u2);
   MediumPoint m;
   ctx_.media.eval(ps, &m);
-  add_sources(m, ps, d, t, y, cam, rng, true, false, out);
+  add_sources(m, ps, d, y_out, t, y, cam, rng, true, false, out);
 }
 
-void MfsIntegrator::add_sources(const MediumPoint& m, const Vec3& p, const Vec3& d, double t,
-                                const CameraPoint& y, const CameraPath& cam, Rng& rng, bool scattered,
-                                bool peak, Sources* out) const {
+void MfsIntegrator::add_sources(const MediumPoint& m, const Vec3& p, const Vec3& d, const ShBasis& y_out,
+                                double t, const CameraPoint& y, const CameraPath& cam, Rng& rng,
+                                bool scattered, bool peak, Sources* out) const {
   for (int i = 0; i < m.count; ++i) {
     if (max_component(m.sigma_s_i[i]) <= 0.0) continue;
-    const MediumRadiance Lm = medium_radiance(i, p, d, t, y, cam, rng);
+    const MediumRadiance Lm = medium_radiance(i, p, d, y_out, t, y, cam, rng);
     if (scattered) out->in_scatter += m.sigma_s_i[i] * Lm.L;
     if (peak) out->peak_scatter += m.sigma_s_i[i] * Lm.L_peak;
     if (scattered) out->lights_scatter += m.sigma_s_i[i] * Lm.L_lights;
   }
 }
 
-MfsIntegrator::MediumRadiance MfsIntegrator::medium_radiance(int i, const Vec3& p, const Vec3& d, double t,
+MfsIntegrator::MediumRadiance MfsIntegrator::medium_radiance(int i, const Vec3& p, const Vec3& d,
+                                                             const ShBasis& y_out, double t,
                                                              const CameraPoint& y, const CameraPath& cam,
                                                              Rng& rng) const {
   const PhaseSplit& split = *splits_[i];
@@ -334,7 +337,7 @@ MfsIntegrator::MediumRadiance MfsIntegrator::medium_radiance(int i, const Vec3& 
   }
   // Add the light that already took wide scatters (and the environment's): its last wide scatter is at y.
   out.L_lights = out.L;
-  if (grid_) out.L += higher_orders(i, p, d, t, y.tau_p, cam);
+  if (grid_) out.L += higher_orders(i, p, y_out, t, y.tau_p, cam);
   return out;
 }
 
@@ -377,8 +380,9 @@ LightBeam MfsIntegrator::light_beam(size_t l, int i, const Vec3& p, const LightS
     exact_light_transmittance(p, ls, &T_light, &T_wide);
     if (!s_.forward_light_path()) T_wide = T_light;
   } else {
-    T_light = full_maps_[l].lookup(p);
-    T_wide = s_.forward_light_path() ? reduced_maps_[l].lookup(p) : T_light;
+    const TrilinearStencil st = full_maps_[l].stencil(p);  // the pair's shared layout (build_pair)
+    T_light = full_maps_[l].lookup(st);
+    T_wide = s_.forward_light_path() ? reduced_maps_[l].lookup(st) : T_light;
   }
   Rgb R(1.0), mean_cos(1.0), toward(0.0);
   const bool traced = beam_ && beam_->lookup(l, p, &R, &mean_cos, &toward);
@@ -391,17 +395,17 @@ LightBeam MfsIntegrator::light_beam(size_t l, int i, const Vec3& p, const LightS
   return b;
 }
 
-Rgb MfsIntegrator::higher_orders(int i, const Vec3& p, const Vec3& d, double t, const Rgb& tau_p,
+Rgb MfsIntegrator::higher_orders(int i, const Vec3& p, const ShBasis& y_out, double t, const Rgb& tau_p,
                                  const CameraPath& cam) const {
   const PhaseSplit& split = *splits_[i];
   const double f = f_[i];
   // forward_side "light": the whole phase function at y, exact camera leg (eq. D12 with D1's moments).
-  if (s_.light_side()) return grid_->scattered(p, -d, whole_phase_moments(split, f, grid_->bands()));
+  if (s_.light_side()) return grid_->scattered(p, y_out, whole_phase_moments(split, f, grid_->bands()));
   // Camera side: the wide part, its moments blurred by the camera-side peak depth (eqs. D3, D12),
   // optionally read pre-filtered over the camera-side lateral spread (eq. D10).
   const std::array<Rgb, kShMaxBands> chi = blurred_wide_moments(split, tau_p, grid_->bands());
-  return (1.0 - f) * (s_.filtered_lookups ? grid_->scattered_filtered(p, -d, chi, cam.lateral_spread(t))
-                                          : grid_->scattered(p, -d, chi));
+  return (1.0 - f) * (s_.filtered_lookups ? grid_->scattered_filtered(p, y_out, chi, cam.lateral_spread(t))
+                                          : grid_->scattered(p, y_out, chi));
 }
 
 }  // namespace nimbus

@@ -142,16 +142,18 @@ class MfsIntegrator final : public Integrator {
   struct Sources {
     Rgb in_scatter{0.0}, peak_scatter{0.0}, lights_scatter{0.0};
   };
-  void add_sources(const MediumPoint& m, const Vec3& p, const Vec3& d, double t, const CameraPoint& y,
-                   const CameraPath& cam, Rng& rng, bool scattered, bool peak, Sources* out) const;
+  // y_out: Y_lm(-d), the scatter grid's basis towards the camera, evaluated once per ray.
+  void add_sources(const MediumPoint& m, const Vec3& p, const Vec3& d, const ShBasis& y_out, double t,
+                   const CameraPoint& y, const CameraPath& cam, Rng& rng, bool scattered, bool peak,
+                   Sources* out) const;
   // source_blur (eq. D14): T_cam's light read at a point of the lateral footprint around p, zero outside
   // the media (the forward peak alone stays on the ray: add_sources at p).
-  void add_blurred_sources(const Vec3& p, const Vec3& d, double t, const CameraPoint& y,
+  void add_blurred_sources(const Vec3& p, const Vec3& d, const ShBasis& y_out, double t, const CameraPoint& y,
                            const CameraPath& cam, Rng& rng, Sources* out) const;
   // What medium i sends towards the camera from the sample point p (at distance t) of the march: one
   // sample of every light (eqs. D7, D11) and the scatter grid's higher orders (eq. D12).
-  MediumRadiance medium_radiance(int i, const Vec3& p, const Vec3& d, double t, const CameraPoint& y,
-                                 const CameraPath& cam, Rng& rng) const;
+  MediumRadiance medium_radiance(int i, const Vec3& p, const Vec3& d, const ShBasis& y_out, double t,
+                                 const CameraPoint& y, const CameraPath& cam, Rng& rng) const;
   // Light l's peak-only beam at p for medium i: shadow maps, beam grid (eqs. D8, D9); an area light
   // marches to its sampled point ls instead of reading a map.
   LightBeam light_beam(size_t l, int i, const Vec3& p, const LightSample& ls) const;
@@ -161,7 +163,7 @@ class MfsIntegrator final : public Integrator {
   // The beam from the environment image along wi (marched: full and reduced transmittance, no beam grid).
   LightBeam environment_beam(int i, const Vec3& p, const Vec3& wi) const;
   // The scatter grid's light, taking its last wide scatter at p towards the camera (eq. D12).
-  Rgb higher_orders(int i, const Vec3& p, const Vec3& d, double t, const Rgb& tau_p,
+  Rgb higher_orders(int i, const Vec3& p, const ShBasis& y_out, double t, const Rgb& tau_p,
                     const CameraPath& cam) const;
 };
 

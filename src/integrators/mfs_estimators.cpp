@@ -6,18 +6,6 @@
 
 namespace nimbus {
 
-namespace {
-// exp of each channel, taken once where neighbouring channels are equal (grey media, the common case): the
-// same values bit for bit as exp(x), a third of the exps.
-Rgb exp_channels(const Rgb& x) {
-  Rgb r;
-  r[0] = std::exp(x[0]);
-  r[1] = x[1] == x[0] ? r[0] : std::exp(x[1]);
-  r[2] = x[2] == x[1] ? r[1] : std::exp(x[2]);
-  return r;
-}
-}  // namespace
-
 double path_lengthening(double theta, double tau) {
   // docs/derivations.md eq. D5: 1 / cosh(x) = 2 e^-x / (1 + e^-2x), x = sqrt(theta tau).
   const double x = std::sqrt(std::max(0.0, theta * tau));
@@ -89,14 +77,25 @@ LightBeam peak_only_beam(const Rgb& T_light, const Rgb& T_wide, bool traced, con
                          bool lengthening) {
   LightBeam b{T_light, T_wide, Rgb(0.0)};
   const double one_minus_chi1 = 1.0 - (peak_moments.size() > 1 ? peak_moments[1] : 1.0);
+  // A channel equal to the one before it in every input takes that channel's values (grey media: one log
+  // instead of three; the same values bit for bit).
   for (int c = 0; c < 3; ++c) {
     if (traced) {
       // eq. D9: the traced beam's loss R, and the peak depth whose spread has its mean cosine (eq. D3
       // at l = 1: mean_cos = exp(-tau_ps (1 - chi_1^peak))).
       b.T_wide[c] *= R[c];
+      if (c > 0 && mean_cos[c] == mean_cos[c - 1]) {
+        b.tau_ps[c] = b.tau_ps[c - 1];
+        continue;
+      }
       b.tau_ps[c] = one_minus_chi1 > 0.0 ? std::min(PhaseSplit::kTauMax,
                                                     -std::log(std::max(mean_cos[c], 1e-12)) / one_minus_chi1)
                                          : 0.0;
+      continue;
+    }
+    if (c > 0 && T_light[c] == T_light[c - 1] && T_wide[c] == T_wide[c - 1]) {
+      b.tau_ps[c] = b.tau_ps[c - 1];
+      b.T_wide[c] = b.T_wide[c - 1];
       continue;
     }
     // eq. D8: the straight beam's peak depth ln(T_wide / T_light), and optionally eq. D5.
@@ -111,8 +110,14 @@ LightBeam peak_only_beam(const Rgb& T_light, const Rgb& T_wide, bool traced, con
 Rgb first_wide_scatter(const Rgb& E, double f, const PhaseSplit& split, const PhaseSplit::Angle& a,
                        const Rgb& tau_p, const Rgb& tau_ps, const Rgb& T_wide) {
   // eq. D7, first term: light- and camera-side peak depths add (eq. D4).
+  // One table lookup per distinct depth (grey media: one for the three channels).
   Rgb L;
-  for (int c = 0; c < 3; ++c) L[c] = E[c] * (1.0 - f) * split.wide_eff(tau_p[c] + tau_ps[c], a) * T_wide[c];
+  double tau_prev = 0.0, eff = 0.0;
+  for (int c = 0; c < 3; ++c) {
+    const double tau = tau_p[c] + tau_ps[c];
+    if (c == 0 || tau != tau_prev) eff = split.wide_eff(tau, a), tau_prev = tau;
+    L[c] = E[c] * (1.0 - f) * eff * T_wide[c];
+  }
   return L;
 }
 
@@ -125,7 +130,11 @@ Rgb forward_peak(const Rgb& E, double f, const PhaseSplit& split, const PhaseSpl
                  const Rgb& T) {
   // eq. D7, second term (or D7b for beer_lambert).
   Rgb L;
-  for (int c = 0; c < 3; ++c) L[c] = E[c] * f * split.peak_eff(tau[c], a) * T[c];
+  double tau_prev = 0.0, eff = 0.0;
+  for (int c = 0; c < 3; ++c) {
+    if (c == 0 || tau[c] != tau_prev) eff = split.peak_eff(tau[c], a), tau_prev = tau[c];
+    L[c] = E[c] * f * eff * T[c];
+  }
   return L;
 }
 

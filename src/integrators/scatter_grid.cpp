@@ -489,16 +489,23 @@ void ScatterGrid::accumulate(int level, const Vec3& p, double wt, double* L) con
   const Level* lv = level > 0 ? &mips_[level - 1] : nullptr;
   const TrilinearStencil st = (lv ? lv->grid : grid_).stencil(p);
   const float* v = lv ? lv->values.data() : values_.data();
-  for (int k = 0; k < 8; ++k) {
-    const float* node = &v[st.node[k] * floats];
-    const double w = wt * st.weight[k];
-    for (int h = 0; h < floats; ++h) L[h] += w * node[h];
-  }
+  // The same sums with the node's size known at compile time for the default 3 bands (27 floats).
+  const auto sum = [&](auto n) {
+    for (int k = 0; k < 8; ++k) {
+      const float* node = &v[st.node[k] * size_t(n())];
+      const double w = wt * st.weight[k];
+      for (int h = 0; h < n(); ++h) L[h] += w * node[h];
+    }
+  };
+  if (floats == 27)
+    sum([] { return 27; });
+  else
+    sum([floats] { return floats; });
 }
 
-Rgb ScatterGrid::evaluate(const double* L, const Vec3& w_out, const std::array<Rgb, kShMaxBands>& chi) const {
-  double y[kShMaxBands * kShMaxBands];
-  sh_eval(w_out, bands_, y);
+Rgb ScatterGrid::evaluate(const double* L, const ShBasis& y_out,
+                          const std::array<Rgb, kShMaxBands>& chi) const {
+  const double* y = y_out.y;
   Rgb r;
   for (int c = 0; c < 3; ++c) {
     double v = 0.0;
@@ -511,23 +518,33 @@ Rgb ScatterGrid::evaluate(const double* L, const Vec3& w_out, const std::array<R
 
 Rgb ScatterGrid::scattered_filtered(const Vec3& p, const Vec3& w_out, const std::array<Rgb, kShMaxBands>& chi,
                                     double spread) const {
+  return scattered_filtered(p, ShBasis(w_out, bands_), chi, spread);
+}
+
+Rgb ScatterGrid::scattered_filtered(const Vec3& p, const ShBasis& y_out,
+                                    const std::array<Rgb, kShMaxBands>& chi, double spread) const {
   if (!grid_.bounds.contains(p)) return Rgb(0.0);
   const double h = grid_.min_spacing();
   const double level = std::clamp(std::log2(std::max(spread, 1e-300) / h), 0.0, double(mips_.size()));
-  if (!(level > 0.0)) return scattered(p, w_out, chi);
+  if (!(level > 0.0)) return scattered(p, y_out, chi);
   double L[3 * kShMaxBands * kShMaxBands] = {};
   const int k0 = std::min(int(level), int(mips_.size()));
   const double f = level - k0;
   accumulate(k0, p, 1.0 - f, L);
   if (f > 0.0) accumulate(k0 + 1, p, f, L);
-  return evaluate(L, w_out, chi);
+  return evaluate(L, y_out, chi);
 }
 
 Rgb ScatterGrid::scattered(const Vec3& p, const Vec3& w_out, const std::array<Rgb, kShMaxBands>& chi) const {
+  return scattered(p, ShBasis(w_out, bands_), chi);
+}
+
+Rgb ScatterGrid::scattered(const Vec3& p, const ShBasis& y_out,
+                           const std::array<Rgb, kShMaxBands>& chi) const {
   if (!grid_.bounds.contains(p)) return Rgb(0.0);
   double L[3 * kShMaxBands * kShMaxBands] = {};
   accumulate(0, p, 1.0, L);
-  return evaluate(L, w_out, chi);
+  return evaluate(L, y_out, chi);
 }
 
 }  // namespace nimbus

@@ -68,10 +68,14 @@ class ScatterGrid {
   // outside the grid), clamped at zero: the radiance a unit of scattering with Legendre moments chi_l
   // (per channel; chi_0 = 1 for a normalised phase function) sends along w_out.
   Rgb scattered(const Vec3& p, const Vec3& w_out, const std::array<Rgb, kShMaxBands>& chi) const;
+  // The same with Y_lm(w_out) evaluated once (ShBasis(w_out, bands())) for many points (bit for bit).
+  Rgb scattered(const Vec3& p, const ShBasis& y_out, const std::array<Rgb, kShMaxBands>& chi) const;
   // The same from the pre-filtered (mip-mapped) grid, for light that reaches the camera from an area
   // of lateral standard deviation `spread` (per component) around p: level log2(spread / spacing),
   // blended between the two nearest levels (level k: 2^k spacings, a tent filter of the level below).
   Rgb scattered_filtered(const Vec3& p, const Vec3& w_out, const std::array<Rgb, kShMaxBands>& chi,
+                         double spread) const;
+  Rgb scattered_filtered(const Vec3& p, const ShBasis& y_out, const std::array<Rgb, kShMaxBands>& chi,
                          double spread) const;
   int bands() const { return bands_; }
 
@@ -98,7 +102,7 @@ class ScatterGrid {
   // The moments at p of level k (0: values_), summed into L with weight wt.
   void accumulate(int level, const Vec3& p, double wt, double* L) const;
   // sum_lm chi_l L_lm Y_lm(w_out) per channel from moments L (as values_ lays out a node), clamped at 0.
-  Rgb evaluate(const double* L, const Vec3& w_out, const std::array<Rgb, kShMaxBands>& chi) const;
+  Rgb evaluate(const double* L, const ShBasis& y_out, const std::array<Rgb, kShMaxBands>& chi) const;
   // The photons of the constructor (settings s) into values_.
   void trace(const SceneContext& ctx, const std::vector<const PhaseSplit*>& splits,
              const std::vector<double>& peak_fraction, const ScatterGridSettings& s);

@@ -28,7 +28,7 @@ Rgb marched_transmittance(const SceneMedia& media, const MajorantGrid& grid, con
     tau += reduced_sigma_t(media, x, peak_fraction) * dt;
     return min_component(tau) < 50.0;
   });
-  return exp(-tau);
+  return exp_channels(-tau);  // grey maps: one exp
 }
 
 namespace {
@@ -234,8 +234,9 @@ void TransmittanceGrid::build_pair(const SceneMedia& media, const MajorantGrid& 
   build(media, grid, light, resolution, tau_step, peak_fraction, full, reduced, how);
 }
 
-Rgb TransmittanceGrid::lookup(const Vec3& p) const {
-  const TrilinearStencil st = grid_.stencil(p);
+Rgb TransmittanceGrid::lookup(const Vec3& p) const { return lookup(grid_.stencil(p)); }
+
+Rgb TransmittanceGrid::lookup(const TrilinearStencil& st) const {
   // Interpolated in optical depth, not in transmittance: exp is convex, so a lerp of T between a node
   // the light reaches and one deep in shadow is too bright (by up to ~50 % where the light grazes a dense
   // medium's boundary, the backlit spheres' rim; docs/validation/render.md), while the depth along the
@@ -246,7 +247,7 @@ Rgb TransmittanceGrid::lookup(const Vec3& p) const {
     const float* v = &values_[st.node[k] * 3];
     tau += Rgb(v[0], v[1], v[2]) * st.weight[k];
   }
-  return exp(-tau);
+  return exp_channels(-tau);  // grey maps: one exp
 }
 
 }  // namespace nimbus

@@ -55,6 +55,10 @@ class TransmittanceGrid {
                          int resolution, double tau_step, const std::vector<double>& peak_fraction,
                          TransmittanceGrid* full, TransmittanceGrid* reduced, MapBuild how = {});
   Rgb lookup(const Vec3& p) const;
+  // The same from the trilinear stencil at p: the pair of build_pair shares its node layout, so one
+  // stencil (either map's) serves both (bit for bit as lookup(p)).
+  TrilinearStencil stencil(const Vec3& p) const { return grid_.stencil(p); }
+  Rgb lookup(const TrilinearStencil& st) const;
   size_t memory_bytes() const { return values_.size() * sizeof(float); }
 
  private:
