@@ -39,7 +39,11 @@
 namespace nimbus {
 
 struct ScatterGridSettings {
-  int photons = 1 << 18;  // per channel pass, shared among the lights (see power_share)
+  int photons = 1 << 18;  // per pass, shared among the lights (see power_share)
+  // Chromatic media: one photon pass per channel, each with that channel's coefficients (true), or one
+  // pass of hero-channel photons carrying all three (false; scatter_grid.cpp's HeroWalk). Grey media
+  // take one pass either way.
+  bool channel_passes = false;
   // The lights' (and the environment's, the media's emission's) shares of the photons: power_share by
   // their power, the rest evenly. 0.8 against 0 (even) lowers the Disney cloud's photon noise variance
   // by ~12 % (its sun has 73 % of the power; docs/benchmarks.md, issue 12).
