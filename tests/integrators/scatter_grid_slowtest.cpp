@@ -59,7 +59,8 @@ Rgb chroma_sum(const SceneContext& ctx, bool channel_passes, bool exact, uint64_
 // Hero-channel photons (one pass, weighted per channel by the balance heuristic) and one pass per
 // channel give grids of the same mean per channel over seeds, within their noise (a z-test of the
 // difference of the means, 4 standard errors per channel), in the true medium and in the similarity
-// one. Without the null collisions' weights the red channel (the least extinction) is ~20 % low.
+// one. Without the null collisions' weights (the walk.update of a null collision dropped) the
+// true medium's channels are -17, -38 and +58 % off.
 TEST(ScatterGrid, HeroChannelsKeepEachChannelsMean) {
   const Scene scene = chroma_scene();
   const SceneContext ctx(scene);
