@@ -20,6 +20,16 @@
 // flights deposit from order 0, so `mfs` needs no environment sampling on the camera ray. An environment
 // image's photons leave it by luminance (integrators/env_light.h): the grid holds its moments l <= 2.
 //
+// Chromatic media (coefficients that differ between channels) take one pass of photons carrying all
+// three channels: photon i of a source is driven by hero channel i mod 3 (that channel's extinction for
+// delta tracking, its scattering shares for the medium) and weighted per channel by the balance
+// heuristic over the three channels' tracking densities (null collisions and scatters alike; the
+// weights are at most 3 x the one-channel walk's albedo products; roulette on the largest channel).
+// Unbiased per channel; in long walks where the channels' extinctions differ the weights all but pick
+// the photons of the channel's own hero, so each channel's noise is about that of a third of the photons
+// (the chromatic box: noise variance ~2.8x at 2^18 photons, for 0.6x the set-up; docs/benchmarks.md).
+// channel_passes keeps the former one pass per channel (each with that channel's coefficients).
+//
 // Deterministic: photon i uses its own random stream; photons are split into a fixed number of
 // batches (each its own grid, summed in order), so the grid does not depend on the thread count.
 // The photons are traced by the shared photon tracer (integrators/photon_tracer.h); the node layout
