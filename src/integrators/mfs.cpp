@@ -36,6 +36,7 @@ MfsSettings mfs_settings_from_json(const nlohmann::json& options, const std::str
   s.photons = int(o.integer("photons", 1, 1 << 26, s.photons));
   s.photon_transport =
       PhotonTransport(o.choice("photon_transport", kPhotonTransportNames, int(s.photon_transport)));
+  s.channel_passes = o.boolean("channel_passes", s.channel_passes);
   if (int64_t n = 0; o.keyword_or_integer("scatter_grid_resolution", "auto", 4, 96, &n))
     s.scatter_grid_resolution = int(n);
   s.scatter_grid_bands = int(o.integer("scatter_grid_bands", 1, kShMaxBands, s.scatter_grid_bands));
@@ -67,6 +68,7 @@ nlohmann::json to_json(const MfsSettings& s) {
                       {"propagator", kPropagatorNames[int(s.propagator)]},
                       {"photons", s.photons},
                       {"photon_transport", kPhotonTransportNames[int(s.photon_transport)]},
+                      {"channel_passes", s.channel_passes},
                       {"scatter_grid_bands", s.scatter_grid_bands},
                       {"forward_side", kForwardSideNames[int(s.forward_side)]},
                       {"beam_photons", s.beam_photons},
@@ -174,6 +176,7 @@ MfsIntegrator::MfsIntegrator(const SceneContext& context, MfsSettings settings, 
     grid.resolution = *s_.scatter_grid_resolution;
     grid.max_wide_scatters = s_.large_angle_scatters.value_or(0);
     grid.exact_transport = s_.photon_transport == PhotonTransport::exact;
+    grid.channel_passes = s_.channel_passes;
     grid.bands = s_.scatter_grid_bands;
     grid.live_nodes_only = !s_.filtered_lookups;  // the pre-filtered levels read every node
     grid.seed = seed;

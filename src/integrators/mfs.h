@@ -35,8 +35,9 @@
 // | `propagator`              | "gsa" or "gaussian"           | "gsa"     | the peak's own moments in the small-angle propagator, or a Gaussian stand-in with the same theta2 |
 // | `peak_fraction`           | "auto" or [0, 0.99]           | "auto"    | f, the part of each phase function carried as a forward peak ("auto": g^2 per medium) |
 // | `large_angle_scatters`    | "all" or integer in [0, 1024] | "all"     | K, at most K wide scatters per path (0: the peak only; 1: the seed's picture) |
-// | `photons`                 | integer in [1, 2^26]          | 262144    | scatter grid photons per channel pass, shared among the lights (80 % by power, 20 % evenly) |
+// | `photons`                 | integer in [1, 2^26]          | 262144    | scatter grid photons per pass, shared among the lights (80 % by power, 20 % evenly) |
 // | `photon_transport`        | "exact" or "similarity"       | "exact"   | scatter grid photons in the true medium, or in the delta-scaled one |
+// | `channel_passes`          | boolean                       | false     | chromatic media: one scatter grid photon pass per colour channel (each with its own coefficients) instead of one pass of hero-channel photons carrying all three (scatter_grid.h) |
 // | `scatter_grid_resolution` | "auto" or integer in [4, 96]  | "auto"    | scatter and beam grid nodes along the longest axis ("auto": ~1.6 optical depths per cell, 32 to 64; the header of a rendered image holds the number chosen) |
 // | `scatter_grid_bands`      | integer in [1, 3]             | 3         | spherical-harmonic bands used at lookup (l < bands) |
 // | `forward_side`            | "camera" or "light"           | "camera"  | peak scatters after the last wide scatter carried to the camera, or taken on the light's side with an exact camera leg |
@@ -81,6 +82,7 @@ struct MfsSettings {
   std::optional<int> large_angle_scatters;  // nullopt: "all"
   int photons = 1 << 18;
   PhotonTransport photon_transport = PhotonTransport::exact;
+  bool channel_passes = false;
   std::optional<int> scatter_grid_resolution;  // nullopt: "auto" (resolved by MfsIntegrator)
   int scatter_grid_bands = 3;
   ForwardSide forward_side = ForwardSide::camera;

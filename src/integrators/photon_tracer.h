@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <functional>
 #include <limits>
+#include <type_traits>
 #include <vector>
 
 #include "core/check.h"
@@ -88,6 +89,8 @@ double majorant_share(const SceneMedia& media, const std::function<double(int)>&
 // photon, true sends it on along the new w from the surface),
 // then on_collision(xc, &w) -> bool at each real collision xc (false ends the photon; it may turn w).
 // At most kMaxPhotonEvents collisions; each one that does not end the photon adds 1 to *collisions.
+// sigma may instead decide each tentative collision itself: sigma(p, maj) -> bool, true for a real
+// collision (the scatter grid's chromatic photons, which weight null collisions per channel).
 template <typename Sigma, typename OnFlight, typename OnCollision, typename OnSurface>
 void walk_photon(const SceneContext& ctx, const MajorantGrid& majorants, Vec3 x, Vec3 w,
                  double majorant_scale, Rng& rng, double* collisions, Sigma&& sigma, OnFlight&& on_flight,
@@ -100,9 +103,15 @@ void walk_photon(const SceneContext& ctx, const MajorantGrid& majorants, Vec3 x,
     const bool to_surface = ctx.surfaces.intersect(x, w, kInf, &surface);
     const bool reached =
         track(majorants, x, w, surface.t, majorant_scale, rng, [&](const Vec3& p, double maj) {
-          const double s = sigma(p);
-          NIMBUS_DCHECK(s >= 0.0 && s <= maj);  // a real collision's probability s / maj in [0, 1]
-          if (rng.uniform() * maj < s) {
+          bool real;
+          if constexpr (std::is_invocable_r_v<bool, Sigma, const Vec3&, double>) {
+            real = sigma(p, maj);
+          } else {
+            const double s = sigma(p);
+            NIMBUS_DCHECK(s >= 0.0 && s <= maj);  // a real collision's probability s / maj in [0, 1]
+            real = rng.uniform() * maj < s;
+          }
+          if (real) {
             hit = true;
             xc = p;
             return false;

@@ -1,5 +1,7 @@
 // The scatter grid (integrators/scatter_grid.h): its photons (through the shared photon tracer), its
 // pre-filtered levels and its lookups.
+// long-file: the photons' two walks (one pass per channel, or hero channels for chromatic media) share
+// the deposit and tally code of this file's anonymous namespace; a second file would have to expose it.
 #include "integrators/scatter_grid.h"
 
 #include <tbb/parallel_for.h>
@@ -187,6 +189,48 @@ void fold_node(const std::vector<SourceBlock>& blocks, size_t rgb_size, int coef
   }
 }
 
+// A photon of chromatic media traced once for all three channels (hero-channel sampling, the balance
+// heuristic over channels: Veach's multi-sample MIS with one technique per channel). Photon i of a
+// source's n is driven by hero channel c = i mod 3 (a_c = n_c / n of them): delta tracking with real
+// collisions at that channel's extinction sigma_c, the medium chosen by its scattering shares. For the
+// path x so drawn, f_k(x) is channel k's contribution (per tentative collision: sigma_s,m[k] at a real
+// scatter in medium m, maj - sigma_t[k] at a null one) and p_j(x) the density of drawing x with hero
+// j; channel k gets
+//     W_k = f_k / sum_j a_j p_j,
+// which is unbiased for every channel (each channel's paths are drawn by its own hero at least) and
+// bounded: W_k <= f_k / (a_k p_k) = (1 / a_k) x the single-channel pass's weight (a product of
+// albedos, <= 1). The walk keeps beta_k = f_k / p_c and r_j = p_j / p_c, both divided by max_j r_j after
+// each event (no overflow over long walks; W = beta / (a . r) is unchanged by the scale). The roulette
+// acts on max_k W_k, which does not depend on the hero, so its survival probability is common to all
+// techniques and divides out. Surfaces weight by their albedo per channel.
+struct HeroWalk {
+  int c;      // the hero channel
+  Rgb a;      // a_j: the share of the source's photons with hero j
+  Rgb beta;   // f_k / p_c (scaled)
+  Rgb r;      // p_j / p_c (scaled by the same factor; max_j r_j = 1)
+  Rgb sigma;  // the extinction at the last tentative collision (all channels)
+  Rgb weight() const { return beta * (1.0 / (a.x * r.x + a.y * r.y + a.z * r.z)); }
+  // An event with channel-k contribution factor f[k] and hero-j density factor p[j] (p[c] > 0).
+  void update(const Rgb& f, const Rgb& p) {
+    const double pc = p[c];
+    NIMBUS_DCHECK(pc > 0.0);
+    beta = beta * f * (1.0 / pc);
+    r = r * p * (1.0 / pc);
+    const double m = max_component(r);
+    NIMBUS_DCHECK(m >= r[c] && m > 0.0);
+    r = r * (1.0 / m);
+    beta = beta * (1.0 / m);
+  }
+  // Roulette below 0.1 on the largest channel's weight; false ends the photon.
+  bool roulette(Rng& rng) {
+    const double w = max_component(weight());
+    if (w >= 0.1) return true;
+    if (rng.uniform() * 0.1 >= w) return false;
+    beta = beta * (0.1 / w);
+    return true;
+  }
+};
+
 // The photons of one scatter grid: which source and channel photon j belongs to, what its flights
 // deposit and what its real collisions do.
 struct ScatterPhotons {
@@ -197,7 +241,8 @@ struct ScatterPhotons {
   const NodeGrid& grid;
   const uint8_t* live;  // per node: 1 where a lookup in the media can read it (null: every node)
   int bands;
-  bool grey;      // one pass carrying RGB power (else one pass per channel)
+  bool grey;      // one pass carrying RGB power (else one pass per channel, or hero channels)
+  bool hero;      // chromatic media in one pass: hero channels with the balance heuristic (HeroWalk)
   size_t lights;  // light sources (then the environment, then the media's emission, if any)
   size_t sources;
   std::vector<size_t> first;        // source i's photons are first[i] .. first[i + 1] - 1 of each pass
@@ -212,6 +257,15 @@ struct ScatterPhotons {
   bool reflect(const SurfaceHit& hit, Vec3* w, int c, double* weight, int* order, Rng& rng) const;
   bool scatter(const Vec3& xc, Vec3* w, int c, double* weight, int* order, Rng& rng,
                PhotonBatch& batch) const;
+  // The new direction after a real collision in medium m (weighted and survived); false ends the photon.
+  bool turn(int m, Vec3* w, int* order, Rng& rng, PhotonBatch& batch) const;
+  // Hero-channel photons of chromatic media (HeroWalk).
+  Rgb extinction(const Vec3& p) const {
+    return s.exact_transport ? ctx.media.sigma_t(p) : reduced_sigma_t(ctx.media, p, peak_fraction);
+  }
+  void trace_hero(const Photon& ph, int hero, const Rgb& share, const TallyBlock& block, int first_order,
+                  Rng& rng, PhotonBatch& batch) const;
+  bool scatter_hero(const Vec3& xc, Vec3* w, HeroWalk& walk, int* order, Rng& rng, PhotonBatch& batch) const;
 };
 
 void ScatterPhotons::trace(size_t j, Rng& rng, PhotonBatch& batch) const {
@@ -236,6 +290,14 @@ void ScatterPhotons::trace(size_t j, Rng& rng, PhotonBatch& batch) const {
   const TallyBlock block{.mono = sb.offset >= 0 ? batch.tally.data() + sb.offset : nullptr,
                          .colour = sb.colour,
                          .channel = sb.channel};
+  if (hero) {
+    // Photon i of the source's n has hero i mod 3; a_j = (photons with hero j) / n.
+    const size_t i = k - first[src], count = first[src + 1] - first[src];
+    Rgb share;
+    for (int h = 0; h < 3; ++h) share[h] = double((count + 2 - size_t(h)) / 3) / double(count);
+    trace_hero(ph, int(i % 3), share, block, first_order, rng, batch);
+    return;
+  }
   Rgb power = ph.power;
   if (!grey)
     for (int k = 0; k < 3; ++k)
@@ -288,7 +350,12 @@ bool ScatterPhotons::scatter(const Vec3& xc, Vec3* w, int c, double* weight, int
     if (rng.uniform() * 0.1 >= *weight) return false;
     *weight = 0.1;
   }
-  const int m = choose_medium(shares, rng);
+  return turn(choose_medium(shares, rng), w, order, rng, batch);
+}
+
+// A real collision's new direction in medium m (exact transport: a phase sample and its peak or wide
+// class; similarity: a wide scatter). False ends the photon (its K-th wide scatter).
+bool ScatterPhotons::turn(int m, Vec3* w, int* order, Rng& rng, PhotonBatch& batch) const {
   const Phase& phase = ctx.media.phase(m);
   const double f = peak_fraction[m];
   // The probability that a scatter into direction cosine mu is a wide one: (1 - f) P_wide / P.
@@ -317,6 +384,84 @@ bool ScatterPhotons::scatter(const Vec3& xc, Vec3* w, int c, double* weight, int
       [&](const Vec3& candidate) { return rng.uniform() < wide_share(dot(candidate, *w)); });
   if (!drawn) ++batch.rejection_failures;  // the photon flies on undeflected (see sample_by_rejection)
   return true;
+}
+
+// A photon of chromatic media with hero channel `hero` (HeroWalk): its power in all three channels,
+// deposits weighted by W.
+void ScatterPhotons::trace_hero(const Photon& ph, int hero, const Rgb& share, const TallyBlock& block,
+                                int first_order, Rng& rng, PhotonBatch& batch) const {
+  if (max_component(ph.power) <= 0.0 || !(share[hero] > 0.0)) return;
+  HeroWalk walk{.c = hero, .a = share, .beta = Rgb(1.0), .r = Rgb(1.0), .sigma = Rgb(0.0)};
+  int order = 0;  // wide scatters so far
+  // A flight's track at distance t is weighted by the null collisions before t only: each null
+  // collision ends a segment, deposited with the weight it had (weighting the whole flight by the
+  // weight at its end biases the channels: the denser ones ~10 % low in the test's sphere).
+  Vec3 seg = ph.x;  // where the current segment starts (on the current flight)
+  const auto deposit = [&](const Vec3& w, double len) {
+    if (order >= first_order)
+      deposit_flight(batch.tally.data(), block, grid, live, bands, seg, w, len, ph.power * walk.weight());
+  };
+  Vec3 dir = ph.w;  // the current flight's direction
+  walk_photon(
+      ctx, s.majorants ? *s.majorants : ctx.majorants, ph.x, ph.w, majorant_scale, rng, &batch.collisions,
+      [&](const Vec3& p, double maj) {
+        // A tentative collision: real with probability sigma_c / maj; a null one weights channel k by
+        // (maj - sigma_k) / (maj - sigma_c) and technique j's density likewise.
+        walk.sigma = extinction(p);
+        NIMBUS_DCHECK(max_component(walk.sigma) <= maj * (1.0 + 1e-9) && min_component(walk.sigma) >= 0.0);
+        if (rng.uniform() * maj < walk.sigma[walk.c]) return true;
+        deposit(dir, (p - seg).length());
+        seg = p;
+        const Rgb null_density(std::max(0.0, maj - walk.sigma.x), std::max(0.0, maj - walk.sigma.y),
+                               std::max(0.0, maj - walk.sigma.z));
+        walk.update(null_density, null_density);
+        return false;
+      },
+      [&](const Vec3& x, const Vec3& w, double t_end) {
+        // The flight's last segment (t_end infinite: the photon leaves; deposit_flight clips it).
+        deposit(w, t_end - (seg - x).length());
+      },
+      [&](const Vec3& xc, Vec3* w) {
+        if (!scatter_hero(xc, w, walk, &order, rng, batch)) return false;
+        seg = xc, dir = *w;
+        return true;
+      },
+      [&](const SurfaceHit& hit, Vec3* w) {
+        // A diffuse surface: a wide scatter weighted by its albedo per channel (as reflect).
+        const auto* diffuse = std::get_if<DiffuseMaterial>(&ctx.surfaces.material(hit.surface));
+        if (!diffuse || ++order >= K) return false;
+        walk.beta = walk.beta * diffuse->albedo;
+        if (!walk.roulette(rng)) return false;
+        const double v1 = rng.uniform(), v2 = rng.uniform();
+        *w = cosine_direction(hit.ns, v1, v2);
+        if (!(dot(*w, hit.ng) > 0.0)) return false;
+        seg = SceneSurfaces::offset(hit, *w), dir = *w;  // where walk_photon's next flight starts
+        return true;
+      });
+}
+
+// A real collision of a hero-channel photon at xc: the medium by the hero's scattering shares, the
+// weights by each channel's scattering in that medium against the hero's density, roulette, direction.
+bool ScatterPhotons::scatter_hero(const Vec3& xc, Vec3* w, HeroWalk& walk, int* order, Rng& rng,
+                                  PhotonBatch& batch) const {
+  MediumPoint mp;
+  ctx.media.eval(xc, &mp);
+  const auto kept = [&](int i) { return s.exact_transport ? 1.0 : 1.0 - peak_fraction[i]; };
+  ScatteringShares shares[3];
+  for (int k = 0; k < 3; ++k) shares[k] = scattering_shares(mp, ctx.media.count(), k, kept);
+  const int c = walk.c;
+  if (!(shares[c].sum > 0.0) || !(walk.sigma[c] > 0.0)) return false;
+  const int m = choose_medium(shares[c], rng);
+  // Per tentative collision (the common 1 / maj dropped): f_k = kept sigma_s,m[k]; p_j = sigma_j x
+  // (medium m's share of channel j's scattering), sigma_j the extinction tracked for channel j.
+  Rgb f, p;
+  for (int k = 0; k < 3; ++k) {
+    f[k] = shares[k].part[m];
+    p[k] = shares[k].sum > 0.0 ? walk.sigma[k] * shares[k].part[m] / shares[k].sum : 0.0;
+  }
+  walk.update(f, p);
+  if (!walk.roulette(rng)) return false;
+  return turn(m, w, order, rng, batch);
 }
 
 // The photons of each source (numbered as ScatterPhotons::trace numbers them) as first[i] ..
@@ -408,7 +553,8 @@ void ScatterGrid::trace(const SceneContext& ctx, const std::vector<const PhaseSp
   // Grey media (every coefficient equal in all channels) take one pass carrying RGB power; otherwise
   // one pass per channel with that channel's coefficients.
   const bool grey = grey_media(ctx);
-  const int passes = grey ? 1 : 3;
+  const bool hero = !grey && !s.channel_passes;
+  const int passes = grey || hero ? 1 : 3;
   const size_t lights = s.max_wide_scatters == 1 ? 0 : ctx.lights.size();  // K = 1: environment only
   // The media's emission is one more source, with its share of the photons (emit_from_media).
   // (Only where a medium scatters does the grid's light reach the camera.)
@@ -430,6 +576,7 @@ void ScatterGrid::trace(const SceneContext& ctx, const std::vector<const PhaseSp
       .live = nullptr,
       .bands = bands_,
       .grey = grey,
+      .hero = hero,
       .lights = lights,
       .sources = sources,
       .first = {},

@@ -20,6 +20,16 @@
 // flights deposit from order 0, so `mfs` needs no environment sampling on the camera ray. An environment
 // image's photons leave it by luminance (integrators/env_light.h): the grid holds its moments l <= 2.
 //
+// Chromatic media (coefficients that differ between channels) take one pass of photons carrying all
+// three channels: photon i of a source is driven by hero channel i mod 3 (that channel's extinction for
+// delta tracking, its scattering shares for the medium) and weighted per channel by the balance
+// heuristic over the three channels' tracking densities (null collisions and scatters alike; the
+// weights are at most 3 x the one-channel walk's albedo products; roulette on the largest channel).
+// Unbiased per channel; in long walks where the channels' extinctions differ the weights all but pick
+// the photons of the channel's own hero, so each channel's noise is about that of a third of the photons
+// (the chromatic box: noise variance ~2.8x at 2^18 photons, for 0.6x the set-up; docs/benchmarks.md).
+// channel_passes keeps the former one pass per channel (each with that channel's coefficients).
+//
 // Deterministic: photon i uses its own random stream; photons are split into a fixed number of
 // batches (each its own grid, summed in order), so the grid does not depend on the thread count.
 // The photons are traced by the shared photon tracer (integrators/photon_tracer.h); the node layout
@@ -39,7 +49,11 @@
 namespace nimbus {
 
 struct ScatterGridSettings {
-  int photons = 1 << 18;  // per channel pass, shared among the lights (see power_share)
+  int photons = 1 << 18;  // per pass, shared among the lights (see power_share)
+  // Chromatic media: one photon pass per channel, each with that channel's coefficients (true), or one
+  // pass of hero-channel photons carrying all three (false; scatter_grid.cpp's HeroWalk). Grey media
+  // take one pass either way.
+  bool channel_passes = false;
   // The lights' (and the environment's, the media's emission's) shares of the photons: power_share by
   // their power, the rest evenly. 0.8 against 0 (even) lowers the Disney cloud's photon noise variance
   // by ~12 % (its sun has 73 % of the power; docs/benchmarks.md, issue 12).

@@ -65,6 +65,7 @@ TEST(Registry, SettingsRoundTripThroughJson) {
                                               {"large_angle_scatters", 2},
                                               {"photons", 1000},
                                               {"photon_transport", "similarity"},
+                                              {"channel_passes", true},
                                               {"scatter_grid_resolution", 16},
                                               {"scatter_grid_bands", 2},
                                               {"forward_side", "camera"},
@@ -87,7 +88,7 @@ TEST(Registry, DefaultsAreWrittenOut) {
   EXPECT_EQ(mfs["large_angle_scatters"], "all");
   EXPECT_EQ(mfs["scatter_grid_resolution"], "auto");
   EXPECT_EQ(mfs["light_path"], "forward");
-  EXPECT_EQ(mfs.size(), 19u);  // every option of the table in mfs.h
+  EXPECT_EQ(mfs.size(), 20u);  // every option of the table in mfs.h
 }
 
 TEST(Registry, UnknownFieldsAndNamesAreErrors) {
