@@ -40,6 +40,35 @@ void splat(float* tally, const NodeGrid& grid, const uint8_t* live, int floats_p
   }
 }
 
+// The same sample whole to one of the 8 nodes, drawn by uniforms u with probability equal to its
+// trilinear weight (Splat::stochastic, Splat::stratified): the expected tally is splat's, one node
+// written instead of 8.
+void splat_one(float* tally, const NodeGrid& grid, const uint8_t* live, int floats_per_node, int first,
+               int count, const Vec3& q, const double u[3], const float* add) {
+  const size_t n = grid.random_node(q, u);
+  if (live && !live[n]) return;
+  float* node = &tally[n * floats_per_node + first];
+  for (int i = 0; i < count; ++i) node[i] += add[i];
+}
+
+// A flight's deposit samples, k = 0 .. n - 1 at x + w (t0 + (k + 0.5) len / n), through `splat` or
+// (with corner uniforms) `splat_one`.
+void splat_flight(float* tally, const NodeGrid& grid, const uint8_t* live, int floats_per_node, int first,
+                  int count, const Vec3& x, const Vec3& w, double t0, double len, int n, const float* add,
+                  CornerUniforms* corners) {
+  if (!corners) {
+    for (int k = 0; k < n; ++k)
+      splat(tally, grid, live, floats_per_node, first, count, x + w * (t0 + (k + 0.5) * len / n), add);
+    return;
+  }
+  corners->start_flight();
+  for (int k = 0; k < n; ++k) {
+    double u[3];
+    corners->next(k, u);
+    splat_one(tally, grid, live, floats_per_node, first, count, x + w * (t0 + (k + 0.5) * len / n), u, add);
+  }
+}
+
 // Where a photon's flights go in its batch's tally: the RGB block (per node: channel c at [coeffs c + h],
 // as ScatterGrid::values_), or, for a source whose photons all carry one colour (grey media, a light
 // or a constant environment), that source's single-colour block (per node: coeffs floats, the power
@@ -54,9 +83,10 @@ struct TallyBlock {
 // Track-length deposit of the flight x + t w, t in [0, t_end] (clipped to the node grid): samples at
 // most kDepositStep spacings apart, each splatting its share of power x length times the harmonics of w
 // (into block.mono when given; else into the RGB block `tally`, where only the channels from the first
-// to the last with non-zero power are touched).
+// to the last with non-zero power are touched); trilinearly, or with `corners` to one node per sample.
 void deposit_flight(float* tally, const TallyBlock& block, const NodeGrid& grid, const uint8_t* live,
-                    int bands, const Vec3& x, const Vec3& w, double t_end, const Rgb& power) {
+                    int bands, const Vec3& x, const Vec3& w, double t_end, const Rgb& power,
+                    CornerUniforms* corners) {
   double t0, t1;
   if (!grid.bounds.intersect(x, w, 0.0, t_end, &t0, &t1)) return;
   const double len = t1 - t0;
@@ -75,8 +105,7 @@ void deposit_flight(float* tally, const TallyBlock& block, const NodeGrid& grid,
     sh_eval(w, bands, y);
     float add[kShMaxBands * kShMaxBands];
     for (int h = 0; h < coeffs; ++h) add[h] = float(a * y[h]);
-    for (int k = 0; k < n; ++k)
-      splat(block.mono, grid, live, coeffs, 0, coeffs, x + w * (t0 + (k + 0.5) * len / n), add);
+    splat_flight(block.mono, grid, live, coeffs, 0, coeffs, x, w, t0, len, n, add, corners);
     return;
   }
   int c_lo = 0, c_hi = 2;
@@ -88,8 +117,7 @@ void deposit_flight(float* tally, const TallyBlock& block, const NodeGrid& grid,
   for (int c = c_lo; c <= c_hi; ++c)
     for (int h = 0; h < coeffs; ++h) add[coeffs * (c - c_lo) + h] = float(v[c] * y[h]);
   const int first = coeffs * c_lo, count = coeffs * (c_hi - c_lo + 1);
-  for (int k = 0; k < n; ++k)
-    splat(tally, grid, live, 3 * coeffs, first, count, x + w * (t0 + (k + 0.5) * len / n), add);
+  splat_flight(tally, grid, live, 3 * coeffs, first, count, x, w, t0, len, n, add, corners);
 }
 
 // The next pre-filtered level: the values (`floats` per node) of `fine` at its nodes 2j, filtered with
@@ -243,6 +271,10 @@ void ScatterPhotons::trace(size_t j, Rng& rng, PhotonBatch& batch) const {
   if (max_component(power) <= 0.0) return;
   double weight = 1.0;
   int order = 0;  // wide scatters so far
+  // A stochastic splat's corner choices: from a stream of the photon's own (its walk's stream untouched).
+  Rng splat_rng(s.seed ^ 0x73706c6174ull, j);
+  CornerUniforms corner_uniforms(s.splat, &splat_rng);
+  CornerUniforms* corners = s.splat == Splat::trilinear ? nullptr : &corner_uniforms;
   walk_photon(
       ctx, s.majorants ? *s.majorants : ctx.majorants, ph.x, ph.w, majorant_scale, rng, &batch.collisions,
       [&](const Vec3& p) {
@@ -250,7 +282,7 @@ void ScatterPhotons::trace(size_t j, Rng& rng, PhotonBatch& batch) const {
       },
       [&](const Vec3& x, const Vec3& w, double t_end) {
         if (order >= first_order)
-          deposit_flight(batch.tally.data(), block, grid, live, bands, x, w, t_end, power * weight);
+          deposit_flight(batch.tally.data(), block, grid, live, bands, x, w, t_end, power * weight, corners);
       },
       [&](const Vec3& xc, Vec3* w) { return scatter(xc, w, c, &weight, &order, rng, batch); },
       [&](const SurfaceHit& hit, Vec3* w) { return reflect(hit, w, c, &weight, &order, rng); });
