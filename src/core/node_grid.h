@@ -37,7 +37,7 @@ inline TrilinearStencil trilinear_stencil(const Vec3& p, const Vec3& lo, const V
   return s;
 }
 
-// How a deposit sample is spread over the nodes around it (the scatter and beam grids' tallies):
+// How a deposit sample is spread over the nodes around it (the scatter grid's tally; ScatterGridSettings):
 //   trilinear:  its value times the 8 trilinear weights, to all 8 nodes;
 //   stochastic: its whole value to one of the 8, drawn with probability equal to its trilinear weight
 //               (per axis the upper node with probability f_a: independent uniforms per sample);

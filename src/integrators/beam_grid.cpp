@@ -27,24 +27,22 @@ constexpr double kDepositStep = 1.0;
 // Which columns a deposit sample goes to.
 enum class Columns { traced, straight, both };
 
-// Adds x (channel ch) to one node's columns: to the straight column, to the traced one and (times mu)
-// the traced x cosine one, or to all three. stride: floats per node; pk: P_peak towards the camera
-// (stride kCameraFloats only).
-void add_to_node(float* node, int stride, int ch, double x, double mu, double pk, Columns to) {
-  if (to != Columns::traced) node[6 + ch] += float(x);
-  if (to != Columns::straight) {
-    node[ch] += float(x);
-    node[3 + ch] += float(x * mu);
-    if (stride == kCameraFloats) node[9 + ch] += float(x * pk);
-  }
-}
-
-// Adds v (channel ch) with trilinear weights st to the tally's columns `to` (add_to_node).
+// Adds v (channel ch) with trilinear weights st to the tally: to the straight column, to the traced one
+// and (times mu) the traced x cosine one, or to all three.
+// stride: floats per node; pk: P_peak towards the camera (stride kCameraFloats only).
 void splat(float* tally, int stride, const TrilinearStencil& st, int ch, double v, double mu, double pk,
            Columns to) {
   for (int j = 0; j < 8; ++j)
-    if (st.weight[j] > 0.0)
-      add_to_node(&tally[st.node[j] * stride], stride, ch, st.weight[j] * v, mu, pk, to);
+    if (st.weight[j] > 0.0) {
+      float* node = &tally[st.node[j] * stride];
+      const double x = st.weight[j] * v;
+      if (to != Columns::traced) node[6 + ch] += float(x);
+      if (to != Columns::straight) {
+        node[ch] += float(x);
+        node[3 + ch] += float(x * mu);
+        if (stride == kCameraFloats) node[9 + ch] += float(x * pk);
+      }
+    }
 }
 
 // The cell of the node grid that holds p (clamped into the grid), as an index over the cells (x fastest).
@@ -122,26 +120,19 @@ struct BeamPhotons {
   int stride;                        // floats per node
   const MajorantGrid* majorants;     // the photons' tracking majorants (null: the scene's)
   const std::vector<uint8_t>& idle;  // per cell of the node grid: see idle_cells
-  Splat splat_mode;                  // how a deposit sample spreads over its nodes
-  uint64_t seed;                     // of the photons' splat streams (stochastic splats)
 
   void trace(size_t j, Rng& rng, PhotonBatch& batch) const;
-  // u: the sample's corner uniforms for a stochastic splat (null: trilinear).
-  void sample(float* tally, const Vec3& q, const Vec3& w, double dl, Rgb* weight, int c, Columns to,
-              const double* u) const;
-  Rgb deposit(float* tally, const Vec3& x, const Vec3& w, double t_end, Rgb weight, int c,
-              CornerUniforms* corners) const;
-  Rgb deposit_first(float* tally, const Vec3& x, const Vec3& w, double t_end, Rgb weight, int c,
-                    CornerUniforms* corners) const;
+  void sample(float* tally, const Vec3& q, const Vec3& w, double dl, Rgb* weight, int c, Columns to) const;
+  Rgb deposit(float* tally, const Vec3& x, const Vec3& w, double t_end, Rgb weight, int c) const;
+  Rgb deposit_first(float* tally, const Vec3& x, const Vec3& w, double t_end, Rgb weight, int c) const;
   bool scatter(const Vec3& xc, Vec3* w, BeamWalk& walk, Rng& rng, PhotonBatch& batch) const;
 };
 
 // One deposit sample at q (the midpoint of a step of length dl of the flight along w): the weight loses
 // exp(-sigma_loss dl) over the step and the midpoint's weight, divided by the straight-line model phi_0
-// T_wide at q, goes to the columns `to`. Channel c only unless grey. Trilinearly, or (uniforms u) whole
-// to one node drawn by its trilinear weight (every channel and column to the same node).
+// T_wide at q, goes to the columns `to`. Channel c only unless grey.
 void BeamPhotons::sample(float* tally, const Vec3& q, const Vec3& w, double dl, Rgb* weight, int c,
-                         Columns to, const double* u) const {
+                         Columns to) const {
   // An idle cell: no loss, and its nodes are read by no lookup that matters (idle_cells).
   if (idle[grid_cell(grid, q)]) return;
   const Rgb loss = reduced_sigma_t(ctx.media, q, peak_fraction);
@@ -164,16 +155,6 @@ void BeamPhotons::sample(float* tally, const Vec3& q, const Vec3& w, double dl, 
   const double mu = !traced ? 1.0 : point ? dot(w, normalize(q - point->position)) : dot(w, dir_w);
   // The peak-only light's last peak scatter towards the camera (the forward-peak term's angular factor).
   const double pk = camera && traced ? splits[0]->peak(dot(w, normalize(*camera - q))) : 0.0;
-  if (u) {
-    float* node = &tally[grid.random_node(q, u) * stride];
-    for (int ch = 0; ch < 3; ++ch) {
-      if ((!grey && ch != c) || !(tw[ch] > 1e-30)) continue;
-      const double v = mid[ch] * dl / (tw[ch] * geo);
-      NIMBUS_DCHECK(v >= 0.0 && std::isfinite(v));
-      add_to_node(node, stride, ch, v, mu, pk, to);
-    }
-    return;
-  }
   const TrilinearStencil st = grid.stencil(q);
   for (int ch = 0; ch < 3; ++ch) {
     if ((!grey && ch != c) || !(tw[ch] > 1e-30)) continue;
@@ -186,21 +167,15 @@ void BeamPhotons::sample(float* tally, const Vec3& q, const Vec3& w, double dl, 
 // Track-length deposit of a traced flight x + t w, t in [0, t_end] (clipped to the grid), starting with
 // `weight` (channel c only unless grey) and losing exp(-int sigma_loss) along the way (midpoint rule at
 // the deposit samples, at most kDepositStep node spacings apart); each sample divided by the
-// straight-line model at that point. Returns the weight at t_end. corners: a stochastic splat's
-// uniforms (null: trilinear).
-Rgb BeamPhotons::deposit(float* tally, const Vec3& x, const Vec3& w, double t_end, Rgb weight, int c,
-                         CornerUniforms* corners) const {
+// straight-line model at that point. Returns the weight at t_end.
+Rgb BeamPhotons::deposit(float* tally, const Vec3& x, const Vec3& w, double t_end, Rgb weight, int c) const {
   double t0, t1;
   if (!grid.bounds.intersect(x, w, 0.0, t_end, &t0, &t1) || !(t1 - t0 > 0.0)) return weight;
   const double len = t1 - t0;
   const int n = std::max(1, int(std::ceil(len / (kDepositStep * grid.min_spacing()))));
   const double dl = len / n;
-  if (corners) corners->start_flight();
-  double u[3];
-  for (int k = 0; k < n; ++k) {
-    if (corners) corners->next(k, u);
-    sample(tally, x + w * (t0 + (k + 0.5) * dl), w, dl, &weight, c, Columns::traced, corners ? u : nullptr);
-  }
+  for (int k = 0; k < n; ++k)
+    sample(tally, x + w * (t0 + (k + 0.5) * dl), w, dl, &weight, c, Columns::traced);
   return weight;
 }
 
@@ -212,11 +187,10 @@ Rgb BeamPhotons::deposit(float* tally, const Vec3& x, const Vec3& w, double t_en
 // over the straight chord at most kDepositStep apart; the traced flight's last, partial step takes a
 // sample of its own. A photon that never scatters deposits the same samples in both columns, so R is 1
 // to rounding wherever nothing deflects the light. Beyond the first peak scatter the straight deposit
-// goes on alone on the same samples (a stochastic splat: the shared samples write both columns to the
-// same node, so R stays 1 there; the straight chord's k-th sample uses the k-th uniforms).
+// goes on alone on the same samples.
 // Returns the traced weight at t_end.
-Rgb BeamPhotons::deposit_first(float* tally, const Vec3& x, const Vec3& w, double t_end, Rgb weight, int c,
-                               CornerUniforms* corners) const {
+Rgb BeamPhotons::deposit_first(float* tally, const Vec3& x, const Vec3& w, double t_end, Rgb weight,
+                               int c) const {
   double t0, t1;
   if (!grid.bounds.intersect(x, w, 0.0, std::numeric_limits<double>::infinity(), &t0, &t1) ||
       !(t1 - t0 > 0.0))
@@ -225,25 +199,16 @@ Rgb BeamPhotons::deposit_first(float* tally, const Vec3& x, const Vec3& w, doubl
   const int n = std::max(1, int(std::ceil(len / (kDepositStep * grid.min_spacing()))));
   const double dl = len / n;
   // Whole steps before t_end: shared.
-  if (corners) corners->start_flight();
-  double u[3];
-  const double* uk = corners ? u : nullptr;
   int k = 0;
-  for (; k < n && t0 + (k + 1) * dl <= t_end; ++k) {
-    if (corners) corners->next(k, u);
-    sample(tally, x + w * (t0 + (k + 0.5) * dl), w, dl, &weight, c, Columns::both, uk);
-  }
+  for (; k < n && t0 + (k + 1) * dl <= t_end; ++k)
+    sample(tally, x + w * (t0 + (k + 0.5) * dl), w, dl, &weight, c, Columns::both);
   if (k == n) return weight;  // the photon left the grid unscattered
   Rgb straight = weight;
   // The traced flight's partial step [t0 + k dl, t_end].
   const double ts = t0 + k * dl, part = std::min(t_end, t1) - ts;
-  if (corners) corners->next(k, u);
-  if (part > 0.0) sample(tally, x + w * (ts + 0.5 * part), w, part, &weight, c, Columns::traced, uk);
+  if (part > 0.0) sample(tally, x + w * (ts + 0.5 * part), w, part, &weight, c, Columns::traced);
   // The rest of the straight chord: its own samples from step k on.
-  for (; k < n; ++k) {
-    if (corners) corners->next(k, u);
-    sample(tally, x + w * (t0 + (k + 0.5) * dl), w, dl, &straight, c, Columns::straight, uk);
-  }
+  for (; k < n; ++k) sample(tally, x + w * (t0 + (k + 0.5) * dl), w, dl, &straight, c, Columns::straight);
   return weight;
 }
 
@@ -262,10 +227,6 @@ void BeamPhotons::trace(size_t j, Rng& rng, PhotonBatch& batch) const {
   walk.w0 = walk.weight[walk.c];
   // The first flight also deposits the same photon undeflected (deposit_first).
   bool first = true;
-  // A stochastic splat's corner choices: from a stream of the photon's own (its walk's stream untouched).
-  Rng splat_rng(seed ^ 0x73706c6174ull, j);
-  CornerUniforms corner_uniforms(splat_mode, &splat_rng);
-  CornerUniforms* corners = splat_mode == Splat::trilinear ? nullptr : &corner_uniforms;
   // Flights end at peak scatters only (rate sum_m f_m sigma_s,m); absorption and wide scatters are the
   // continuous loss exp(-int sigma_loss) on the weight (zero variance in a uniform medium).
   const auto peak_share = [&](int i) { return peak_fraction[i]; };
@@ -276,8 +237,8 @@ void BeamPhotons::trace(size_t j, Rng& rng, PhotonBatch& batch) const {
         return scattering_shares(walk.mp, ctx.media.count(), walk.c, peak_share).sum;
       },
       [&](const Vec3& x, const Vec3& w, double t_end) {
-        walk.weight = first ? deposit_first(batch.tally.data(), x, w, t_end, walk.weight, walk.c, corners)
-                            : deposit(batch.tally.data(), x, w, t_end, walk.weight, walk.c, corners);
+        walk.weight = first ? deposit_first(batch.tally.data(), x, w, t_end, walk.weight, walk.c)
+                            : deposit(batch.tally.data(), x, w, t_end, walk.weight, walk.c);
         first = false;
       },
       [&](const Vec3& xc, Vec3* w) { return scatter(xc, w, walk, rng, batch); },
@@ -324,8 +285,7 @@ bool BeamPhotons::scatter(const Vec3& xc, Vec3* w, BeamWalk& walk, Rng& rng, Pho
 BeamGrid::BeamGrid(const SceneContext& ctx, const std::vector<const PhaseSplit*>& splits,
                    const std::vector<double>& peak_fraction,
                    const std::vector<TransmittanceGrid>& reduced_maps, int photons, int resolution,
-                   uint64_t seed, const Vec3* camera, const MajorantGrid* majorants, bool skip_idle,
-                   Splat splat)
+                   uint64_t seed, const Vec3* camera, const MajorantGrid* majorants, bool skip_idle)
     : stride_(camera ? kCameraFloats : kBaseFloats) {
   if (camera) camera_ = *camera;
   values_.resize(ctx.lights.size());
@@ -365,9 +325,7 @@ BeamGrid::BeamGrid(const SceneContext& ctx, const std::vector<const PhaseSplit*>
                            .camera = camera ? &camera_ : nullptr,
                            .stride = stride_,
                            .majorants = majorants,
-                           .idle = idle,
-                           .splat_mode = splat,
-                           .seed = seed ^ (uint64_t(l) << 40)};
+                           .idle = idle};
     // The batches' sums divided by the node volume.
     values_[l] = trace_photons(
         total, seed ^ 0x7065616b6265616dull ^ (uint64_t(l) << 40), grid_.size() * size_t(stride_),

@@ -35,12 +35,11 @@ class BeamGrid {
  public:
   // reduced_maps[l]: light l's T_wide; photons: per light; resolution as ScatterGridSettings.
   // skip_idle: no deposits in cells with no medium in them or next to them (the lookup is the same
-  // wherever there is a medium; for tests: false deposits everywhere). splat: how a deposit sample
-  // spreads over the nodes around it (core/node_grid.h: trilinearly, or whole to one drawn by its weight).
+  // wherever there is a medium; for tests: false deposits everywhere).
   BeamGrid(const SceneContext& ctx, const std::vector<const PhaseSplit*>& splits,
            const std::vector<double>& peak_fraction, const std::vector<TransmittanceGrid>& reduced_maps,
            int photons, int resolution, uint64_t seed, const Vec3* camera = nullptr,
-           const MajorantGrid* majorants = nullptr, bool skip_idle = true, Splat splat = Splat::trilinear);
+           const MajorantGrid* majorants = nullptr, bool skip_idle = true);
   // R for light `light` at p (trilinear between nodes) and the peak-only light's mean cosine to the
   // straight direction from the light; false (nothing written) outside the grid and for other lights.
   // With a camera, peak_toward (if not null) gets the traced beam's P_peak (medium 0's) towards the camera,

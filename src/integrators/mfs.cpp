@@ -167,8 +167,7 @@ MfsIntegrator::MfsIntegrator(const SceneContext& context, MfsSettings settings, 
     const bool toward = s_.peak_toward_camera && ctx_.media.count() == 1;
     beam_ =
         std::make_unique<BeamGrid>(ctx_, splits, f_, reduced_maps_, s_.beam_photons,
-                                   *s_.scatter_grid_resolution, seed, toward ? &camera : nullptr, tracking,
-                                   /*skip_idle=*/true, s_.photon_splat);
+                                   *s_.scatter_grid_resolution, seed, toward ? &camera : nullptr, tracking);
   }
   // Wide scatters 2 .. K from the scatter grid (for K = 1 only the environment's light).
   if (s_.large_angle_scatters != 0 &&

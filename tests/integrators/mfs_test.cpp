@@ -500,38 +500,6 @@ TEST(Mfs, ExactLightTransmittanceAtABacklitRim) {
   EXPECT_GT(worst_map, 2.0 * worst_exact);  // the option is read, and it is what fixes the rim
 }
 
-// The beam grid with a stochastic splat: with nothing to deflect the light every traced deposit sample
-// is also a straight one, and both go to the same node (deposit_first), so R and the mean cosine stay 1
-// to rounding at every node a photon reached, although each sample wrote one node only.
-TEST(Mfs, BeamGridStochasticSplatKeepsTheStraightBeam) {
-  const Scene scene = test::scene_from_json("{" + test::camera_json(8, 8) + R"(,
-    "media": [{"shape": {"type": "box", "min": [-1, -1, -1], "max": [1, 1, 1]}, "sigma_s": 0.0,
-               "sigma_a": [0.5, 1.0, 1.5], "phase": {"type": "hg", "g": 0.9}}],
-    "lights": [{"type": "directional", "direction": [0.3, 1, -0.2], "irradiance": 2.0}]})");
-  const SceneContext ctx(scene);
-  MfsSettings ms = mfs_settings_from_json(nlohmann::json::object(), "test");
-  ms.large_angle_scatters = 0;
-  ms.beam_photons = 0;
-  const MfsIntegrator mfs(ctx, ms);
-  const std::vector<const PhaseSplit*> splits{&mfs.split(0)};
-  const std::vector<double> f{mfs.split(0).f()};
-  std::vector<TransmittanceGrid> maps;
-  maps.emplace_back(ctx.media, ctx.majorants, ctx.lights[0], 32, 0.25, f);
-  for (Splat splat : {Splat::stochastic, Splat::stratified}) {
-    const BeamGrid beam(ctx, splits, f, maps, 2048, 16, 3, nullptr, nullptr, true, splat);
-    Rng rng(3, 0);
-    for (int i = 0; i < 200; ++i) {
-      const Vec3 p(1.9 * rng.uniform() - 0.95, 1.9 * rng.uniform() - 0.95, 1.9 * rng.uniform() - 0.95);
-      Rgb R, mu;
-      ASSERT_TRUE(beam.lookup(0, p, &R, &mu));
-      for (int c = 0; c < 3; ++c) {
-        EXPECT_NEAR(R[c], 1.0, 1e-5) << int(splat) << " at " << p.x << " " << p.y << " " << p.z;
-        EXPECT_NEAR(mu[c], 1.0, 1e-5);
-      }
-    }
-  }
-}
-
 // peak_toward_camera: in an optically thin sphere the peak-only beam is the light's own direction, so the
 // traced P_peak towards the camera is P_peak at the angle between the light's travel and the camera.
 TEST(Mfs, BeamGridTalliesThePeakTowardsTheCamera) {
