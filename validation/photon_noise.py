@@ -13,6 +13,8 @@ reports per option set:
   fom     noise^2 x set-up CPU (lower is better).
 Usage: photon_noise.py --nimbus build/bin/nimbus --label NAME [--seeds 2] [--set integrator.X=V ...]
 Several option sets: --variant 'name:integrator.a=1;integrator.b=2' (repeatable; 'base:' = none).
+--scene NAME: a scene of validation/mfs_validation.py's suite instead of the cloud, at its reference's
+size, against --refs/NAME_pt2048.exr (validation/setup_error.py's references); --res applies to the cloud.
 """
 import argparse, json, math, os, resource, subprocess, sys
 
@@ -22,7 +24,7 @@ from exr_reader import read_exr
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 SCENE = os.path.join(HERE, '..', 'scenes', 'disney_cloud.json')
-REF = '/work/main/validation/refs/disney_cloud_128x128_pt512.exr'
+REF = ['/work/main/validation/refs/disney_cloud_128x128_pt512.exr']  # --scene replaces it
 
 
 def timed(cmd):
@@ -49,7 +51,7 @@ def seed_noise(paths):
     """sqrt(mean over the reference's bins >= 0.05 x its mean of the seeds' sample variance) / the
     reference's mean over those bins: the rel RMSE of one image against its own mean (for two seeds,
     the pair's compare rel RMSE / sqrt(2) up to the normalisation by the reference)."""
-    ref = binned_luminance(REF)
+    ref = binned_luminance(REF[0])
     mask = ref >= 0.05 * ref.mean()
     imgs = np.stack([binned_luminance(p) for p in paths])
     var = imgs.var(axis=0, ddof=1)
@@ -64,7 +66,19 @@ def main():
     ap.add_argument('--variant', action='append', default=[])
     ap.add_argument('--res', default='128x128')
     ap.add_argument('--no-setup', action='store_true', help='skip the 4x3 set-up timing')
+    ap.add_argument('--scene', help="a scene of mfs_validation.py's suite instead of the cloud")
+    ap.add_argument('--refs', default='/work/refs', help='references for --scene')
     args = ap.parse_args()
+    scene = SCENE
+    if args.scene:
+        sys.path.insert(0, HERE)
+        import mfs_validation as mv
+        s, base, _ = mv.suite()[args.scene]
+        scene = os.path.join(base, f'.photon_noise_{os.getpid()}.json')
+        json.dump(s, open(scene, 'w'))
+        REF[0] = os.path.join(args.refs, f'{args.scene}_pt2048.exr')
+        h, w = binned_luminance(REF[0]).shape
+        args.res = f'{4 * w}x{4 * h}'
     variants = args.variant or ['base:']
     out_dir = f'/tmp/photon_noise/{args.label}'
     os.makedirs(out_dir, exist_ok=True)
@@ -77,7 +91,7 @@ def main():
         imgs, cpu, setup = [], [], []
         for seed in range(1, args.seeds + 1):
             img = f'{out_dir}/{name}_s{seed}.exr'
-            base = [args.nimbus, 'render', SCENE, '--integrator', 'mfs', '--spp', '1', '--threads', '2',
+            base = [args.nimbus, 'render', scene, '--integrator', 'mfs', '--spp', '1', '--threads', '2',
                     '--seed', str(seed), '-q'] + extra
             cpu.append(timed(base + ['--res', args.res, '-o', img]))
             if not args.no_setup:
@@ -85,7 +99,7 @@ def main():
             imgs.append(img)
         pairs = [(imgs[i], imgs[i + 1]) for i in range(0, len(imgs) - 1, 2)]
         noise = [compare(args.nimbus, a, b)['rel_rmse'] / math.sqrt(2) for a, b in pairs]
-        refs = [compare(args.nimbus, a, REF) for a in imgs]
+        refs = [compare(args.nimbus, a, REF[0]) for a in imgs]
         r = dict(name=name, sets=sets, noise=seed_noise(imgs), noises=noise,
                  ref_rmse=sum(x['rel_rmse'] for x in refs) / len(refs),
                  ref_mean=sum(x['mean_rel_error'] for x in refs) / len(refs),
@@ -97,6 +111,8 @@ def main():
               f"cpu {r['cpu']:5.2f} s  setup {r['setup']:5.2f} s  fom {r['fom']:6.2f}", flush=True)
     with open(f'{out_dir}/result.json', 'w') as f:
         json.dump(rows, f, indent=1)
+    if scene != SCENE:
+        os.remove(scene)
 
 
 if __name__ == '__main__':

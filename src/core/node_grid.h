@@ -9,6 +9,7 @@
 #include <cstddef>
 
 #include "core/math.h"
+#include "core/rng.h"
 
 namespace nimbus {
 
@@ -36,6 +37,68 @@ inline TrilinearStencil trilinear_stencil(const Vec3& p, const Vec3& lo, const V
   return s;
 }
 
+// How a deposit sample is spread over the nodes around it (the scatter grid's tally; ScatterGridSettings):
+//   trilinear:  its value times the 8 trilinear weights, to all 8 nodes;
+//   stochastic: its whole value to one of the 8, drawn with probability equal to its trilinear weight
+//               (per axis the upper node with probability f_a: independent uniforms per sample);
+//   stratified: the same draw, the uniforms of a flight's k-th sample frac(s + k alpha) (the R3
+//               sequence, alpha = (1/phi3, 1/phi3^2, 1/phi3^3), shifted by one uniform triple s per
+//               flight), so the choices along a track are spread out rather than independent.
+// The two stochastic splats' expected tally is the trilinear one (each sample's uniforms are uniform);
+// they write one node per sample instead of 8 (docs/benchmarks.md, issue 12).
+enum class Splat { trilinear, stochastic, stratified };
+
+// The corner (bit a: upper node along axis a, the TrilinearStencil's numbering) of the cell of the
+// point with fractional coordinates f (each in [0, 1]) that uniforms u (each in [0, 1)) draw: upper
+// along axis a iff u_a < f_a, so corner k has probability equal to its trilinear weight.
+inline int trilinear_corner(const double f[3], const double u[3]) {
+  return (u[0] < f[0] ? 1 : 0) | (u[1] < f[1] ? 2 : 0) | (u[2] < f[2] ? 4 : 0);
+}
+
+// The uniforms of a flight's deposit samples for a stochastic or stratified splat, from a photon's own
+// splat stream (so the tally does not depend on the thread count).
+class CornerUniforms {
+ public:
+  CornerUniforms(Splat mode, Rng* rng) : mode_(mode), rng_(rng) {}
+  // A new flight (stratified: a new shift).
+  void start_flight() {
+    if (mode_ == Splat::stratified)
+      for (double& s : shift_) s = rng_->next_u32() * 0x1.0p-32;
+  }
+  // The uniforms of the flight's sample k.
+  void next(int k, double u[3]) {
+    if (mode_ == Splat::stratified) {
+      constexpr double kAlpha[3] = {0.8191725133961645, 0.6710436067037893, 0.5497004779019703};
+      for (int a = 0; a < 3; ++a) {
+        const double v = shift_[a] + k * kAlpha[a];
+        u[a] = v - std::floor(v);
+      }
+    } else {
+      for (int a = 0; a < 3; ++a) u[a] = rng_->next_u32() * 0x1.0p-32;
+    }
+  }
+
+ private:
+  Splat mode_;
+  Rng* rng_;
+  double shift_[3] = {0.0, 0.0, 0.0};
+};
+
+// The node that uniforms u draw among the 8 around p (clamped into the grid) with probability equal to
+// its trilinear weight (trilinear_corner).
+inline size_t trilinear_random_node(const Vec3& p, const Vec3& lo, const Vec3& spacing,
+                                    const std::array<int, 3>& nodes, const double u[3]) {
+  int i[3];
+  double f[3];
+  for (int a = 0; a < 3; ++a) {
+    const double t = std::clamp((p[a] - lo[a]) / spacing[a], 0.0, double(nodes[a] - 1));
+    i[a] = std::min(int(t), nodes[a] - 2);
+    f[a] = t - i[a];
+  }
+  const int k = trilinear_corner(f, u);
+  return (size_t(i[2] + (k >> 2)) * nodes[1] + i[1] + (k >> 1 & 1)) * nodes[0] + i[0] + (k & 1);
+}
+
 struct NodeGrid {
   Bounds bounds{Vec3(0.0), Vec3(1.0)};  // lo: node (0, 0, 0); hi: the last node (see the layouts)
   std::array<int, 3> nodes{2, 2, 2};    // per axis, each >= 2
@@ -48,6 +111,10 @@ struct NodeGrid {
   double cell_volume() const { return spacing.x * spacing.y * spacing.z; }
   // The 8 nodes around p and their trilinear weights (p clamped into the grid).
   TrilinearStencil stencil(const Vec3& p) const { return trilinear_stencil(p, bounds.lo, spacing, nodes); }
+  // One of them, drawn with probability equal to its weight by uniforms u (trilinear_random_node).
+  size_t random_node(const Vec3& p, const double u[3]) const {
+    return trilinear_random_node(p, bounds.lo, spacing, nodes, u);
+  }
 };
 
 // Nodes on the box `b` itself (first and last node on its faces), `resolution` nodes along its longest

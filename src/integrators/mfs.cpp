@@ -21,6 +21,7 @@ const std::vector<std::string> kLightPathNames = {"forward", "beer_lambert"};
 const std::vector<std::string> kPropagatorNames = {"gsa", "gaussian"};
 const std::vector<std::string> kPhotonTransportNames = {"exact", "similarity"};
 const std::vector<std::string> kForwardSideNames = {"camera", "light"};
+const std::vector<std::string> kSplatNames = {"trilinear", "stochastic", "stratified"};  // as Splat
 }  // namespace
 
 MfsSettings mfs_settings_from_json(const nlohmann::json& options, const std::string& where) {
@@ -42,6 +43,7 @@ MfsSettings mfs_settings_from_json(const nlohmann::json& options, const std::str
   s.scatter_grid_bands = int(o.integer("scatter_grid_bands", 1, kShMaxBands, s.scatter_grid_bands));
   s.forward_side = ForwardSide(o.choice("forward_side", kForwardSideNames, int(s.forward_side)));
   s.beam_photons = int(o.integer("beam_photons", 0, 1 << 24, s.beam_photons));
+  s.photon_splat = Splat(o.choice("photon_splat", kSplatNames, int(s.photon_splat)));
   s.light_blur = o.boolean("light_blur", s.light_blur);
   s.path_lengthening = o.boolean("path_lengthening", s.path_lengthening);
   s.filtered_lookups = o.boolean("filtered_lookups", s.filtered_lookups);
@@ -72,6 +74,7 @@ nlohmann::json to_json(const MfsSettings& s) {
                       {"scatter_grid_bands", s.scatter_grid_bands},
                       {"forward_side", kForwardSideNames[int(s.forward_side)]},
                       {"beam_photons", s.beam_photons},
+                      {"photon_splat", kSplatNames[int(s.photon_splat)]},
                       {"light_blur", s.light_blur},
                       {"path_lengthening", s.path_lengthening},
                       {"filtered_lookups", s.filtered_lookups},
@@ -179,6 +182,7 @@ MfsIntegrator::MfsIntegrator(const SceneContext& context, MfsSettings settings, 
     grid.channel_passes = s_.channel_passes;
     grid.bands = s_.scatter_grid_bands;
     grid.live_nodes_only = !s_.filtered_lookups;  // the pre-filtered levels read every node
+    grid.splat = s_.photon_splat;
     grid.seed = seed;
     grid.majorants = tracking;
     grid_ = std::make_unique<ScatterGrid>(ctx_, splits, f_, grid);

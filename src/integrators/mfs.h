@@ -42,6 +42,7 @@
 // | `scatter_grid_bands`      | integer in [1, 3]             | 3         | spherical-harmonic bands used at lookup (l < bands) |
 // | `forward_side`            | "camera" or "light"           | "camera"  | peak scatters after the last wide scatter carried to the camera, or taken on the light's side with an exact camera leg |
 // | `beam_photons`            | integer in [0, 2^24]          | 32768     | photons per light for the peak-only beam grid (0: straight beams) |
+// | `photon_splat`            | "trilinear", "stochastic" or "stratified" | "trilinear" | how the scatter grid's photons deposit each track sample: over the 8 nodes around it, or whole to one of them drawn by its trilinear weight (independently, or stratified along the track); the same expected grid, more noise (the beam grid stays trilinear) |
 // | `light_blur`              | boolean                       | true      | the first wide scatter sees the beam's light-side angular spread |
 // | `path_lengthening`        | boolean                       | false     | the corrected kernel's 1 / cosh loss on paths lengthened by peak deflections |
 // | `filtered_lookups`        | boolean                       | false     | scatter grid read pre-filtered over the camera-side lateral spread |
@@ -87,6 +88,7 @@ struct MfsSettings {
   int scatter_grid_bands = 3;
   ForwardSide forward_side = ForwardSide::camera;
   int beam_photons = 1 << 15;
+  Splat photon_splat = Splat::trilinear;
   bool light_blur = true;
   bool path_lengthening = false;
   bool filtered_lookups = false;

@@ -42,6 +42,35 @@ void splat(float* tally, const NodeGrid& grid, const uint8_t* live, int floats_p
   }
 }
 
+// The same sample whole to one of the 8 nodes, drawn by uniforms u with probability equal to its
+// trilinear weight (Splat::stochastic, Splat::stratified): the expected tally is splat's, one node
+// written instead of 8.
+void splat_one(float* tally, const NodeGrid& grid, const uint8_t* live, int floats_per_node, int first,
+               int count, const Vec3& q, const double u[3], const float* add) {
+  const size_t n = grid.random_node(q, u);
+  if (live && !live[n]) return;
+  float* node = &tally[n * floats_per_node + first];
+  for (int i = 0; i < count; ++i) node[i] += add[i];
+}
+
+// A flight's deposit samples, k = 0 .. n - 1 at x + w (t0 + (k + 0.5) len / n), through `splat` or
+// (with corner uniforms) `splat_one`.
+void splat_flight(float* tally, const NodeGrid& grid, const uint8_t* live, int floats_per_node, int first,
+                  int count, const Vec3& x, const Vec3& w, double t0, double len, int n, const float* add,
+                  CornerUniforms* corners) {
+  if (!corners) {
+    for (int k = 0; k < n; ++k)
+      splat(tally, grid, live, floats_per_node, first, count, x + w * (t0 + (k + 0.5) * len / n), add);
+    return;
+  }
+  corners->start_flight();
+  for (int k = 0; k < n; ++k) {
+    double u[3];
+    corners->next(k, u);
+    splat_one(tally, grid, live, floats_per_node, first, count, x + w * (t0 + (k + 0.5) * len / n), u, add);
+  }
+}
+
 // Where a photon's flights go in its batch's tally: the RGB block (per node: channel c at [coeffs c + h],
 // as ScatterGrid::values_), or, for a source whose photons all carry one colour (grey media, a light
 // or a constant environment), that source's single-colour block (per node: coeffs floats, the power
@@ -56,9 +85,10 @@ struct TallyBlock {
 // Track-length deposit of the flight x + t w, t in [0, t_end] (clipped to the node grid): samples at
 // most kDepositStep spacings apart, each splatting its share of power x length times the harmonics of w
 // (into block.mono when given; else into the RGB block `tally`, where only the channels from the first
-// to the last with non-zero power are touched).
+// to the last with non-zero power are touched); trilinearly, or with `corners` to one node per sample.
 void deposit_flight(float* tally, const TallyBlock& block, const NodeGrid& grid, const uint8_t* live,
-                    int bands, const Vec3& x, const Vec3& w, double t_end, const Rgb& power) {
+                    int bands, const Vec3& x, const Vec3& w, double t_end, const Rgb& power,
+                    CornerUniforms* corners) {
   double t0, t1;
   if (!grid.bounds.intersect(x, w, 0.0, t_end, &t0, &t1)) return;
   const double len = t1 - t0;
@@ -77,8 +107,7 @@ void deposit_flight(float* tally, const TallyBlock& block, const NodeGrid& grid,
     sh_eval(w, bands, y);
     float add[kShMaxBands * kShMaxBands];
     for (int h = 0; h < coeffs; ++h) add[h] = float(a * y[h]);
-    for (int k = 0; k < n; ++k)
-      splat(block.mono, grid, live, coeffs, 0, coeffs, x + w * (t0 + (k + 0.5) * len / n), add);
+    splat_flight(block.mono, grid, live, coeffs, 0, coeffs, x, w, t0, len, n, add, corners);
     return;
   }
   int c_lo = 0, c_hi = 2;
@@ -90,8 +119,7 @@ void deposit_flight(float* tally, const TallyBlock& block, const NodeGrid& grid,
   for (int c = c_lo; c <= c_hi; ++c)
     for (int h = 0; h < coeffs; ++h) add[coeffs * (c - c_lo) + h] = float(v[c] * y[h]);
   const int first = coeffs * c_lo, count = coeffs * (c_hi - c_lo + 1);
-  for (int k = 0; k < n; ++k)
-    splat(tally, grid, live, 3 * coeffs, first, count, x + w * (t0 + (k + 0.5) * len / n), add);
+  splat_flight(tally, grid, live, 3 * coeffs, first, count, x, w, t0, len, n, add, corners);
 }
 
 // The next pre-filtered level: the values (`floats` per node) of `fine` at its nodes 2j, filtered with
@@ -264,7 +292,7 @@ struct ScatterPhotons {
     return s.exact_transport ? ctx.media.sigma_t(p) : reduced_sigma_t(ctx.media, p, peak_fraction);
   }
   void trace_hero(const Photon& ph, int hero, const Rgb& share, const TallyBlock& block, int first_order,
-                  Rng& rng, PhotonBatch& batch) const;
+                  CornerUniforms* corners, Rng& rng, PhotonBatch& batch) const;
   bool scatter_hero(const Vec3& xc, Vec3* w, HeroWalk& walk, int* order, Rng& rng, PhotonBatch& batch) const;
 };
 
@@ -290,12 +318,16 @@ void ScatterPhotons::trace(size_t j, Rng& rng, PhotonBatch& batch) const {
   const TallyBlock block{.mono = sb.offset >= 0 ? batch.tally.data() + sb.offset : nullptr,
                          .colour = sb.colour,
                          .channel = sb.channel};
+  // A stochastic splat's corner choices: from a stream of the photon's own (its walk's stream untouched).
+  Rng splat_rng(s.seed ^ 0x73706c6174ull, j);
+  CornerUniforms corner_uniforms(s.splat, &splat_rng);
+  CornerUniforms* corners = s.splat == Splat::trilinear ? nullptr : &corner_uniforms;
   if (hero) {
     // Photon i of the source's n has hero i mod 3; a_j = (photons with hero j) / n.
     const size_t i = k - first[src], count = first[src + 1] - first[src];
     Rgb share;
     for (int h = 0; h < 3; ++h) share[h] = double((count + 2 - size_t(h)) / 3) / double(count);
-    trace_hero(ph, int(i % 3), share, block, first_order, rng, batch);
+    trace_hero(ph, int(i % 3), share, block, first_order, corners, rng, batch);
     return;
   }
   Rgb power = ph.power;
@@ -312,7 +344,7 @@ void ScatterPhotons::trace(size_t j, Rng& rng, PhotonBatch& batch) const {
       },
       [&](const Vec3& x, const Vec3& w, double t_end) {
         if (order >= first_order)
-          deposit_flight(batch.tally.data(), block, grid, live, bands, x, w, t_end, power * weight);
+          deposit_flight(batch.tally.data(), block, grid, live, bands, x, w, t_end, power * weight, corners);
       },
       [&](const Vec3& xc, Vec3* w) { return scatter(xc, w, c, &weight, &order, rng, batch); },
       [&](const SurfaceHit& hit, Vec3* w) { return reflect(hit, w, c, &weight, &order, rng); });
@@ -389,7 +421,8 @@ bool ScatterPhotons::turn(int m, Vec3* w, int* order, Rng& rng, PhotonBatch& bat
 // A photon of chromatic media with hero channel `hero` (HeroWalk): its power in all three channels,
 // deposits weighted by W.
 void ScatterPhotons::trace_hero(const Photon& ph, int hero, const Rgb& share, const TallyBlock& block,
-                                int first_order, Rng& rng, PhotonBatch& batch) const {
+                                int first_order, CornerUniforms* corners, Rng& rng,
+                                PhotonBatch& batch) const {
   if (max_component(ph.power) <= 0.0 || !(share[hero] > 0.0)) return;
   HeroWalk walk{.c = hero, .a = share, .beta = Rgb(1.0), .r = Rgb(1.0), .sigma = Rgb(0.0)};
   int order = 0;  // wide scatters so far
@@ -399,7 +432,8 @@ void ScatterPhotons::trace_hero(const Photon& ph, int hero, const Rgb& share, co
   Vec3 seg = ph.x;  // where the current segment starts (on the current flight)
   const auto deposit = [&](const Vec3& w, double len) {
     if (order >= first_order)
-      deposit_flight(batch.tally.data(), block, grid, live, bands, seg, w, len, ph.power * walk.weight());
+      deposit_flight(batch.tally.data(), block, grid, live, bands, seg, w, len, ph.power * walk.weight(),
+                     corners);
   };
   Vec3 dir = ph.w;  // the current flight's direction
   walk_photon(

@@ -4,6 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
+#include <cmath>
+#include <limits>
 #include <vector>
 
 #include "core/check.h"
@@ -98,6 +101,83 @@ TEST(CheckDeathTest, FailedDcheckNamesTheConditionAndAborts) {
   EXPECT_DEATH(NIMBUS_DCHECK(1 + 1 == 3), "NIMBUS_DCHECK\\(1 \\+ 1 == 3\\) failed");
 }
 #endif
+
+// Pearson's chi-square of corner counts (n draws) against the trilinear weights of fractions f
+// (infinite if a corner of weight 0 was drawn).
+double corner_chi2(const double f[3], const std::array<int, 8>& counts, int n) {
+  double chi2 = 0.0;
+  for (int k = 0; k < 8; ++k) {
+    const double p = (k & 1 ? f[0] : 1 - f[0]) * (k & 2 ? f[1] : 1 - f[1]) * (k & 4 ? f[2] : 1 - f[2]);
+    const double expected = p * n;
+    if (expected > 0.0)
+      chi2 += (counts[k] - expected) * (counts[k] - expected) / expected;
+    else if (counts[k] > 0)
+      return std::numeric_limits<double>::infinity();  // a corner of weight 0 drawn
+  }
+  return chi2;
+}
+
+// The stochastic splat's corner (trilinear_corner from CornerUniforms, independent or stratified along
+// a flight) has probability equal to its trilinear weight: a chi-square test (7 degrees of freedom,
+// 99.99 % point 29.9) at random fractions. The same test rejects the nearest corner, and a draw that
+// picks each axis's upper node with probability 1 - f (the weights mirrored).
+TEST(NodeGrid, StochasticCornerHasTheTrilinearProbabilities) {
+  constexpr int kDraws = 20000;
+  constexpr double kChi2Limit = 29.9;
+  Rng pick(5, 0);
+  for (Splat mode : {Splat::stochastic, Splat::stratified}) {
+    for (int t = 0; t < 10; ++t) {
+      const double f[3] = {pick.uniform(), pick.uniform(), t == 0 ? 0.0 : pick.uniform()};
+      Rng rng(17, uint64_t(t));
+      CornerUniforms corners(mode, &rng);
+      corners.start_flight();
+      std::array<int, 8> counts{}, nearest{}, mirrored{};
+      for (int k = 0; k < kDraws; ++k) {
+        double u[3];
+        corners.next(k, u);
+        ++counts[trilinear_corner(f, u)];
+        const double g[3] = {1 - f[0], 1 - f[1], 1 - f[2]};
+        ++mirrored[trilinear_corner(g, u)];
+        ++nearest[(f[0] >= 0.5 ? 1 : 0) | (f[1] >= 0.5 ? 2 : 0) | (f[2] >= 0.5 ? 4 : 0)];
+      }
+      EXPECT_LT(corner_chi2(f, counts, kDraws), kChi2Limit) << int(mode) << " " << t;
+      EXPECT_GT(corner_chi2(f, nearest, kDraws), kChi2Limit) << int(mode) << " " << t;
+      if (std::abs(f[0] - 0.5) + std::abs(f[1] - 0.5) > 0.1)
+        EXPECT_GT(corner_chi2(f, mirrored, kDraws), kChi2Limit) << int(mode) << " " << t;
+    }
+  }
+}
+
+// NodeGrid::random_node draws one of the stencil's nodes with its weight: the mean of a tally of many
+// unit samples at random points, one node each, equals the trilinear tally within its noise (per node,
+// 5 binomial standard errors), and no node outside the stencils is written.
+TEST(NodeGrid, RandomNodeTallyMatchesTrilinear) {
+  const NodeGrid g = node_grid_padded(Bounds{Vec3(0.0), Vec3(2.0, 1.0, 1.0)}, 5);
+  std::vector<double> tri(g.size(), 0.0), one(g.size(), 0.0);
+  Rng rng(23, 0), splat(29, 0);
+  CornerUniforms corners(Splat::stochastic, &splat);
+  constexpr int kSamples = 200000;
+  for (int i = 0; i < kSamples; ++i) {
+    // Points in a small box so that each node gets many samples.
+    const Vec3 p(0.4 + 0.3 * rng.uniform(), 0.3 + 0.3 * rng.uniform(), 0.5 + 0.2 * rng.uniform());
+    const TrilinearStencil st = g.stencil(p);
+    for (int k = 0; k < 8; ++k) tri[st.node[k]] += st.weight[k];
+    double u[3];
+    corners.next(i, u);
+    one[g.random_node(p, u)] += 1.0;
+  }
+  int written = 0;
+  for (size_t n = 0; n < g.size(); ++n) {
+    if (tri[n] == 0.0) {
+      EXPECT_EQ(one[n], 0.0);
+      continue;
+    }
+    ++written;
+    // Each sample lands on n with probability w_n(p): variance sum w (1 - w) <= tri[n].
+    EXPECT_NEAR(one[n], tri[n], 5.0 * std::sqrt(tri[n]) + 1e-9) << n;
+  }
+  EXPECT_GE(written, 8);
+}
 
 }  // namespace
 }  // namespace nimbus

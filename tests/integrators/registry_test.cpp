@@ -70,6 +70,7 @@ TEST(Registry, SettingsRoundTripThroughJson) {
                                               {"scatter_grid_bands", 2},
                                               {"forward_side", "camera"},
                                               {"beam_photons", 0},
+                                              {"photon_splat", "stratified"},
                                               {"light_blur", false},
                                               {"path_lengthening", true},
                                               {"filtered_lookups", true},
@@ -88,7 +89,8 @@ TEST(Registry, DefaultsAreWrittenOut) {
   EXPECT_EQ(mfs["large_angle_scatters"], "all");
   EXPECT_EQ(mfs["scatter_grid_resolution"], "auto");
   EXPECT_EQ(mfs["light_path"], "forward");
-  EXPECT_EQ(mfs.size(), 20u);  // every option of the table in mfs.h
+  EXPECT_EQ(mfs["photon_splat"], "trilinear");
+  EXPECT_EQ(mfs.size(), 21u);  // every option of the table in mfs.h
 }
 
 TEST(Registry, UnknownFieldsAndNamesAreErrors) {

@@ -26,7 +26,8 @@ Scene split_scene(bool sky) {
 
 // The grid's scattered light summed over fixed points and directions (an isotropic phase function's
 // moments l <= 2, chi = 1, 0.5, 0.25) for photons split with power_share `share`, seed `seed`.
-double grid_sum(const SceneContext& ctx, double share, uint64_t seed, int photons) {
+double grid_sum(const SceneContext& ctx, double share, uint64_t seed, int photons,
+                Splat splat = Splat::trilinear) {
   const Phase& phase = ctx.media.phase(0);
   const PhaseSplit split(phase, auto_peak_fraction(phase));
   ScatterGridSettings s;
@@ -34,6 +35,7 @@ double grid_sum(const SceneContext& ctx, double share, uint64_t seed, int photon
   s.resolution = 12;
   s.power_share = share;
   s.seed = seed;
+  s.splat = splat;
   const ScatterGrid grid(ctx, {&split}, {split.f()}, s);
   std::array<Rgb, kShMaxBands> chi;
   for (int l = 0; l < kShMaxBands; ++l) chi[l] = Rgb(std::pow(0.5, l));
@@ -125,6 +127,33 @@ TEST(ScatterGrid, LiveNodesOnlyKeepTheMediaBitForBit) {
             gap_live = live.scattered(Vec3(0, 0, 0), Vec3(0, 0, 1), chi);
   EXPECT_GT(gap_full[0], 0.0);
   EXPECT_EQ(gap_live[0], 0.0);
+}
+
+// The stochastic splats (one node per deposit sample, drawn by its trilinear weight) keep the grid's
+// mean: the same photons (the same seed: the walks do not depend on the splat) deposited trilinearly and
+// stochastically, over seeds; the paired differences' mean is 0 within 4 of its standard errors. And
+// the grids differ (the splat noise is there), by more than rounding.
+TEST(ScatterGrid, StochasticSplatKeepsTheMean) {
+  const Scene scene = split_scene(true);
+  const SceneContext ctx(scene);
+  constexpr int kSeeds = 12;
+  for (Splat splat : {Splat::stochastic, Splat::stratified}) {
+    double mean = 0.0, sq = 0.0, base = 0.0;
+    for (int k = 0; k < kSeeds; ++k) {
+      const double tri = grid_sum(ctx, 0.8, 100 + k, 2048);
+      const double d = grid_sum(ctx, 0.8, 100 + k, 2048, splat) - tri;
+      mean += d / kSeeds;
+      sq += d * d;
+      base += tri / kSeeds;
+    }
+    const double se = std::sqrt(std::max(0.0, sq / kSeeds - mean * mean) / (kSeeds - 1));
+    std::printf("splat %d: trilinear %.5f, stochastic - trilinear %.5f +- %.5f\n", int(splat), base, mean,
+                se);
+    ASSERT_GT(base, 0.0);
+    EXPECT_GT(se, 1e-5 * base);  // the splat's own noise
+    EXPECT_LT(se, 0.05 * base);
+    EXPECT_NEAR(mean, 0.0, 4.0 * se);
+  }
 }
 
 }  // namespace
