@@ -325,7 +325,7 @@ MfsIntegrator::MediumRadiance MfsIntegrator::medium_radiance(int i, const Vec3& 
   for (size_t l = 0; l < ctx_.lights.size(); ++l) {
     LightSample ls;
     const double u1 = rng.uniform(), u2 = rng.uniform();
-    if (!sample_light(ctx_.lights[l], p, u1, u2, &ls)) continue;
+    if (!sample_light(ctx_.lights[l], ctx_.light_constants[l], p, u1, u2, &ls)) continue;
     if (ctx_.surfaces.occluded(p, ls.wi, ls.distance)) continue;  // a surface shadows y
     add_light(ls, light_beam(l, i, p, ls));
   }
