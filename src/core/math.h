@@ -28,11 +28,12 @@ inline double min_component(const Rgb& c) { return std::min({c.x, c.y, c.z}); }
 inline double average(const Rgb& c) { return (c.x + c.y + c.z) / 3.0; }
 inline double luminance(const Rgb& c) { return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z; }
 inline Rgb exp(const Rgb& c) { return {std::exp(c.x), std::exp(c.y), std::exp(c.z)}; }
-// exp of each channel, taken once where neighbouring channels are equal (grey media, the common case): the
-// same values bit for bit as exp(c), a third of the exps.
+// exp of each channel, taken once where neighbouring channels are equal (grey media, the common case), and
+// not at all for a zero (exp(+-0) = 1 exactly: an empty step, a camera-side blur of l = 0): the same values
+// bit for bit as exp(c), a third of the exps or none.
 inline Rgb exp_channels(const Rgb& c) {
   Rgb r;
-  r.x = std::exp(c.x);
+  r.x = c.x == 0.0 ? 1.0 : std::exp(c.x);
   r.y = c.y == c.x ? r.x : std::exp(c.y);
   r.z = c.z == c.y ? r.y : std::exp(c.z);
   return r;

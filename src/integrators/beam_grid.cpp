@@ -336,8 +336,13 @@ BeamGrid::BeamGrid(const SceneContext& ctx, const std::vector<const PhaseSplit*>
 
 bool BeamGrid::lookup(size_t light, const Vec3& p, Rgb* factor, Rgb* mean_cosine, Rgb* peak_toward) const {
   if (light >= values_.size() || values_[light].empty() || !grid_.bounds.contains(p)) return false;
+  return lookup(light, p, grid_.stencil(p), factor, mean_cosine, peak_toward);
+}
+
+bool BeamGrid::lookup(size_t light, const Vec3& p, const TrilinearStencil& st, Rgb* factor, Rgb* mean_cosine,
+                      Rgb* peak_toward) const {
+  if (light >= values_.size() || values_[light].empty() || !grid_.bounds.contains(p)) return false;
   const std::vector<float>& v = values_[light];
-  const TrilinearStencil st = grid_.stencil(p);
   Rgb r(0.0), m(0.0), straight(0.0), pk(0.0);
   for (int k = 0; k < 8; ++k)
     for (int c = 0; c < 3; ++c) {

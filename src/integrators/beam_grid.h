@@ -45,6 +45,10 @@ class BeamGrid {
   // With a camera, peak_toward (if not null) gets the traced beam's P_peak (medium 0's) towards the camera,
   // averaged over its directions: the angular factor of the forward peak alone (eq. D7's peak_eff).
   bool lookup(size_t light, const Vec3& p, Rgb* factor, Rgb* mean_cosine, Rgb* peak_toward = nullptr) const;
+  // The same from st, node_grid().stencil(p), found once for grids of the same layout (the scatter grid's).
+  bool lookup(size_t light, const Vec3& p, const TrilinearStencil& st, Rgb* factor, Rgb* mean_cosine,
+              Rgb* peak_toward = nullptr) const;
+  const NodeGrid& node_grid() const { return grid_; }
   bool has_camera() const { return stride_ > 9; }
   size_t memory_bytes() const;
   // Peak scatters whose direction the rejection sampler could not draw (the photon flew on

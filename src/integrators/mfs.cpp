@@ -187,6 +187,11 @@ MfsIntegrator::MfsIntegrator(const SceneContext& context, MfsSettings settings, 
     grid.majorants = tracking;
     grid_ = std::make_unique<ScatterGrid>(ctx_, splits, f_, grid);
   }
+  if (grid_ && beam_) {
+    const NodeGrid &a = grid_->node_grid(), &b = beam_->node_grid();
+    shared_stencil_ = a.bounds.lo == b.bounds.lo && a.bounds.hi == b.bounds.hi && a.nodes == b.nodes &&
+                      a.spacing == b.spacing;
+  }
 }
 
 size_t MfsIntegrator::memory_bytes() const {
@@ -282,9 +287,11 @@ void MfsIntegrator::add_blurred_sources(const Vec3& p, const Vec3& d, const ShBa
 void MfsIntegrator::add_sources(const MediumPoint& m, const Vec3& p, const Vec3& d, const ShBasis& y_out,
                                 double t, const CameraPoint& y, const CameraPath& cam, Rng& rng,
                                 bool scattered, bool peak, Sources* out) const {
+  std::optional<TrilinearStencil> st;
+  if (shared_stencil_) st = grid_->node_grid().stencil(p);
   for (int i = 0; i < m.count; ++i) {
     if (max_component(m.sigma_s_i[i]) <= 0.0) continue;
-    const MediumRadiance Lm = medium_radiance(i, p, d, y_out, t, y, cam, rng);
+    const MediumRadiance Lm = medium_radiance(i, p, d, y_out, t, y, cam, rng, st ? &*st : nullptr);
     if (scattered) out->in_scatter += m.sigma_s_i[i] * Lm.L;
     if (peak) out->peak_scatter += m.sigma_s_i[i] * Lm.L_peak;
     if (scattered) out->lights_scatter += m.sigma_s_i[i] * Lm.L_lights;
@@ -294,7 +301,7 @@ void MfsIntegrator::add_sources(const MediumPoint& m, const Vec3& p, const Vec3&
 MfsIntegrator::MediumRadiance MfsIntegrator::medium_radiance(int i, const Vec3& p, const Vec3& d,
                                                              const ShBasis& y_out, double t,
                                                              const CameraPoint& y, const CameraPath& cam,
-                                                             Rng& rng) const {
+                                                             Rng& rng, const TrilinearStencil* st) const {
   const PhaseSplit& split = *splits_[i];
   const double f = f_[i];
   MediumRadiance out{Rgb(0.0), Rgb(0.0), Rgb(0.0)};
@@ -325,9 +332,9 @@ MfsIntegrator::MediumRadiance MfsIntegrator::medium_radiance(int i, const Vec3& 
   for (size_t l = 0; l < ctx_.lights.size(); ++l) {
     LightSample ls;
     const double u1 = rng.uniform(), u2 = rng.uniform();
-    if (!sample_light(ctx_.lights[l], p, u1, u2, &ls)) continue;
+    if (!sample_light(ctx_.lights[l], ctx_.light_constants[l], p, u1, u2, &ls)) continue;
     if (ctx_.surfaces.occluded(p, ls.wi, ls.distance)) continue;  // a surface shadows y
-    add_light(ls, light_beam(l, i, p, ls));
+    add_light(ls, light_beam(l, i, p, ls, st));
   }
   // An environment image is one more light: a direction drawn as its photons leave it (the image by
   // luminance, with any constant part), so that the grid, which carries the image's photons only
@@ -344,7 +351,7 @@ MfsIntegrator::MediumRadiance MfsIntegrator::medium_radiance(int i, const Vec3& 
   }
   // Add the light that already took wide scatters (and the environment's): its last wide scatter is at y.
   out.L_lights = out.L;
-  if (grid_) out.L += higher_orders(i, p, y_out, t, y.tau_p, cam);
+  if (grid_) out.L += higher_orders(i, p, y_out, t, y.tau_p, cam, st);
   return out;
 }
 
@@ -378,7 +385,8 @@ void MfsIntegrator::exact_light_transmittance(const Vec3& p, const LightSample& 
   marched_full_and_reduced(ctx_, p, ls.wi, ls.distance, kSurfaceShadowStep, f_, T_light, T_wide);
 }
 
-LightBeam MfsIntegrator::light_beam(size_t l, int i, const Vec3& p, const LightSample& ls) const {
+LightBeam MfsIntegrator::light_beam(size_t l, int i, const Vec3& p, const LightSample& ls,
+                                    const TrilinearStencil* st) const {
   Rgb T_light, T_wide;
   if (is_area_light(ctx_.lights[l])) {  // an area light: march to its sampled point instead of a map
     marched_full_and_reduced(ctx_, p, ls.wi, ls.distance, kSurfaceShadowStep, f_, &T_light, &T_wide);
@@ -387,12 +395,13 @@ LightBeam MfsIntegrator::light_beam(size_t l, int i, const Vec3& p, const LightS
     exact_light_transmittance(p, ls, &T_light, &T_wide);
     if (!s_.forward_light_path()) T_wide = T_light;
   } else {
-    const TrilinearStencil st = full_maps_[l].stencil(p);  // the pair's shared layout (build_pair)
-    T_light = full_maps_[l].lookup(st);
-    T_wide = s_.forward_light_path() ? reduced_maps_[l].lookup(st) : T_light;
+    const TrilinearStencil map_st = full_maps_[l].stencil(p);  // the pair's shared layout (build_pair)
+    T_light = full_maps_[l].lookup(map_st);
+    T_wide = s_.forward_light_path() ? reduced_maps_[l].lookup(map_st) : T_light;
   }
   Rgb R(1.0), mean_cos(1.0), toward(0.0);
-  const bool traced = beam_ && beam_->lookup(l, p, &R, &mean_cos, &toward);
+  const bool traced = beam_ && (st ? beam_->lookup(l, p, *st, &R, &mean_cos, &toward)
+                                   : beam_->lookup(l, p, &R, &mean_cos, &toward));
   LightBeam b = peak_only_beam(T_light, T_wide, traced, R, mean_cos, splits_[i]->peak_moments(), theta2_[i],
                                s_.forward_light_path() && s_.path_lengthening);
   if (traced && beam_->has_camera()) {
@@ -403,16 +412,19 @@ LightBeam MfsIntegrator::light_beam(size_t l, int i, const Vec3& p, const LightS
 }
 
 Rgb MfsIntegrator::higher_orders(int i, const Vec3& p, const ShBasis& y_out, double t, const Rgb& tau_p,
-                                 const CameraPath& cam) const {
+                                 const CameraPath& cam, const TrilinearStencil* st) const {
   const PhaseSplit& split = *splits_[i];
   const double f = f_[i];
+  const auto scattered = [&](const std::array<Rgb, kShMaxBands>& chi) {
+    return st ? grid_->scattered(p, *st, y_out, chi) : grid_->scattered(p, y_out, chi);
+  };
   // forward_side "light": the whole phase function at y, exact camera leg (eq. D12 with D1's moments).
-  if (s_.light_side()) return grid_->scattered(p, y_out, whole_phase_moments(split, f, grid_->bands()));
+  if (s_.light_side()) return scattered(whole_phase_moments(split, f, grid_->bands()));
   // Camera side: the wide part, its moments blurred by the camera-side peak depth (eqs. D3, D12),
   // optionally read pre-filtered over the camera-side lateral spread (eq. D10).
   const std::array<Rgb, kShMaxBands> chi = blurred_wide_moments(split, tau_p, grid_->bands());
   return (1.0 - f) * (s_.filtered_lookups ? grid_->scattered_filtered(p, y_out, chi, cam.lateral_spread(t))
-                                          : grid_->scattered(p, y_out, chi));
+                                          : scattered(chi));
 }
 
 }  // namespace nimbus

@@ -134,6 +134,7 @@ class MfsIntegrator final : public Integrator {
   std::vector<TransmittanceGrid> full_maps_, reduced_maps_;  // per light
   std::unique_ptr<ScatterGrid> grid_;                        // wide scatters 2 .. K (null for K = 1)
   std::unique_ptr<BeamGrid> beam_;                           // the peak-only beams' correction (or null)
+  bool shared_stencil_ = false;  // both photon grids, on one node layout: one stencil per march point
 
   // The parts of `Li` (mfs.cpp); the physics is in mfs_estimators.h.
   struct MediumRadiance {
@@ -147,6 +148,8 @@ class MfsIntegrator final : public Integrator {
     Rgb in_scatter{0.0}, peak_scatter{0.0}, lights_scatter{0.0};
   };
   // y_out: Y_lm(-d), the scatter grid's basis towards the camera, evaluated once per ray.
+  // The photon grids' trilinear stencil at p is found once for both where they share a layout (st: null
+  // where each finds its own).
   void add_sources(const MediumPoint& m, const Vec3& p, const Vec3& d, const ShBasis& y_out, double t,
                    const CameraPoint& y, const CameraPath& cam, Rng& rng, bool scattered, bool peak,
                    Sources* out) const;
@@ -157,10 +160,12 @@ class MfsIntegrator final : public Integrator {
   // What medium i sends towards the camera from the sample point p (at distance t) of the march: one
   // sample of every light (eqs. D7, D11) and the scatter grid's higher orders (eq. D12).
   MediumRadiance medium_radiance(int i, const Vec3& p, const Vec3& d, const ShBasis& y_out, double t,
-                                 const CameraPoint& y, const CameraPath& cam, Rng& rng) const;
+                                 const CameraPoint& y, const CameraPath& cam, Rng& rng,
+                                 const TrilinearStencil* st) const;
   // Light l's peak-only beam at p for medium i: shadow maps, beam grid (eqs. D8, D9); an area light
   // marches to its sampled point ls instead of reading a map.
-  LightBeam light_beam(size_t l, int i, const Vec3& p, const LightSample& ls) const;
+  LightBeam light_beam(size_t l, int i, const Vec3& p, const LightSample& ls,
+                       const TrilinearStencil* st) const;
   // exact_light_transmittance: T_light and T_wide from p to the light sample without the shadow maps (a
   // closed-form chord for one analytic medium, else a march).
   void exact_light_transmittance(const Vec3& p, const LightSample& ls, Rgb* T_light, Rgb* T_wide) const;
@@ -168,7 +173,7 @@ class MfsIntegrator final : public Integrator {
   LightBeam environment_beam(int i, const Vec3& p, const Vec3& wi) const;
   // The scatter grid's light, taking its last wide scatter at p towards the camera (eq. D12).
   Rgb higher_orders(int i, const Vec3& p, const ShBasis& y_out, double t, const Rgb& tau_p,
-                    const CameraPath& cam) const;
+                    const CameraPath& cam, const TrilinearStencil* st) const;
 };
 
 }  // namespace nimbus

@@ -666,10 +666,12 @@ void ScatterGrid::build_mips() {
 }
 
 void ScatterGrid::accumulate(int level, const Vec3& p, double wt, double* L) const {
-  const int floats = 3 * coeffs_;
   const Level* lv = level > 0 ? &mips_[level - 1] : nullptr;
-  const TrilinearStencil st = (lv ? lv->grid : grid_).stencil(p);
-  const float* v = lv ? lv->values.data() : values_.data();
+  accumulate((lv ? lv->grid : grid_).stencil(p), lv ? lv->values.data() : values_.data(), wt, L);
+}
+
+void ScatterGrid::accumulate(const TrilinearStencil& st, const float* v, double wt, double* L) const {
+  const int floats = 3 * coeffs_;
   // The same sums with the node's size known at compile time for the default 3 bands (27 floats).
   const auto sum = [&](auto n) {
     for (int k = 0; k < 8; ++k) {
@@ -725,6 +727,14 @@ Rgb ScatterGrid::scattered(const Vec3& p, const ShBasis& y_out,
   if (!grid_.bounds.contains(p)) return Rgb(0.0);
   double L[3 * kShMaxBands * kShMaxBands] = {};
   accumulate(0, p, 1.0, L);
+  return evaluate(L, y_out, chi);
+}
+
+Rgb ScatterGrid::scattered(const Vec3& p, const TrilinearStencil& st, const ShBasis& y_out,
+                           const std::array<Rgb, kShMaxBands>& chi) const {
+  if (!grid_.bounds.contains(p)) return Rgb(0.0);
+  double L[3 * kShMaxBands * kShMaxBands] = {};
+  accumulate(st, values_.data(), 1.0, L);
   return evaluate(L, y_out, chi);
 }
 

@@ -89,6 +89,10 @@ class ScatterGrid {
   Rgb scattered(const Vec3& p, const Vec3& w_out, const std::array<Rgb, kShMaxBands>& chi) const;
   // The same with Y_lm(w_out) evaluated once (ShBasis(w_out, bands())) for many points (bit for bit).
   Rgb scattered(const Vec3& p, const ShBasis& y_out, const std::array<Rgb, kShMaxBands>& chi) const;
+  // The same from st, node_grid().stencil(p), found once for grids of the same layout (the beam grid's).
+  Rgb scattered(const Vec3& p, const TrilinearStencil& st, const ShBasis& y_out,
+                const std::array<Rgb, kShMaxBands>& chi) const;
+  const NodeGrid& node_grid() const { return grid_; }
   // The same from the pre-filtered (mip-mapped) grid, for light that reaches the camera from an area
   // of lateral standard deviation `spread` (per component) around p: level log2(spread / spacing),
   // blended between the two nearest levels (level k: 2^k spacings, a tent filter of the level below).
@@ -120,6 +124,8 @@ class ScatterGrid {
   std::vector<Level> mips_;  // levels 1, 2, ...
   // The moments at p of level k (0: values_), summed into L with weight wt.
   void accumulate(int level, const Vec3& p, double wt, double* L) const;
+  // The same from the level's stencil st at p and its values v.
+  void accumulate(const TrilinearStencil& st, const float* v, double wt, double* L) const;
   // sum_lm chi_l L_lm Y_lm(w_out) per channel from moments L (as values_ lays out a node), clamped at 0.
   Rgb evaluate(const double* L, const ShBasis& y_out, const std::array<Rgb, kShMaxBands>& chi) const;
   // The photons of the constructor (settings s) into values_.

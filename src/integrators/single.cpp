@@ -83,7 +83,7 @@ Rgb SingleScatter::trace(const Ray& ray, Rng& rng, CameraSample* sample, int bou
           for (size_t l = 0; l < ctx_.lights.size(); ++l) {
             LightSample ls;
             const double u1 = rng.uniform(), u2 = rng.uniform();
-            if (!sample_light(ctx_.lights[l], p, u1, u2, &ls)) continue;
+            if (!sample_light(ctx_.lights[l], ctx_.light_constants[l], p, u1, u2, &ls)) continue;
             const double f = phase_eval(phase, dot(d, ls.wi));
             if (f <= 0.0) continue;
             Li += ls.weight * f * light_transmittance(l, p, ls, rng);

@@ -317,6 +317,12 @@ DensityGrid DensityGrid::from_nanovdb(nanovdb::GridHandle<nanovdb::HostBuffer> h
   g.grid_ = grid;
   static std::atomic<uint64_t> next_id{1};
   g.id_ = next_id.fetch_add(1);
+  const nanovdb::Map& map = grid->map();
+  const double* inv = map.mInvMatD;
+  g.axis_aligned_ =
+      inv[1] == 0.0 && inv[2] == 0.0 && inv[3] == 0.0 && inv[5] == 0.0 && inv[6] == 0.0 && inv[7] == 0.0;
+  for (int k = 0; k < 9; ++k) g.inv_mat_[k] = inv[k];
+  for (int a = 0; a < 3; ++a) g.vec_[a] = map.mVecD[a];
   int hi_i[3];
   for (int a = 0; a < 3; ++a) {
     g.lo_i_[a] = w.bbox.min()[a] - 1;
@@ -360,7 +366,7 @@ DensityGrid DensityGrid::from_nanovdb(nanovdb::GridHandle<nanovdb::HostBuffer> h
   return g;
 }
 
-Vec3 DensityGrid::world_to_index(const Vec3& p) const {
+Vec3 DensityGrid::world_to_index_map(const Vec3& p) const {
   const auto q = grid_->worldToIndex(nanovdb::Vec3d(p.x, p.y, p.z));
   return {q[0], q[1], q[2]};
 }

@@ -87,8 +87,15 @@ class DensityGrid {
                                   double read_seconds = 0.0, double check_seconds = 0.0,
                                   uint64_t dense_max_bytes = kDenseMaxBytes);
 
-  // Index space <-> the grid's world space (the file's own transform).
-  Vec3 world_to_index(const Vec3& grid_world) const;
+  // Index space <-> the grid's world space (the file's own transform). world_to_index: NanoVDB's
+  // worldToIndex, inline where the map is axis-aligned (see axis_aligned_).
+  Vec3 world_to_index(const Vec3& grid_world) const {
+    if (!axis_aligned_) return world_to_index_map(grid_world);
+    const double* m = inv_mat_;
+    const double x = grid_world.x - vec_[0], y = grid_world.y - vec_[1], z = grid_world.z - vec_[2];
+    return {x * m[0] + (y * m[1] + z * m[2]), x * m[3] + (y * m[4] + z * m[5]),
+            x * m[6] + (y * m[7] + z * m[8])};
+  }
   Vec3 index_to_world(const Vec3& index) const;
 
   // Trilinear density at an index-space position (negative voxels clamped to 0); 0 outside
@@ -151,6 +158,7 @@ class DensityGrid {
   struct Data;  // owns the NanoVDB buffer, the brick array and the stats (shared by copies)
 
  private:
+  Vec3 world_to_index_map(const Vec3& grid_world) const;  // NanoVDB's Map::applyInverseMap
   template <typename Acc>
   double trilinear(Acc& acc, const Vec3& p) const;
   double trilinear_dense(const Vec3& p) const;
@@ -178,6 +186,15 @@ class DensityGrid {
   const float* dense_ = nullptr;
   int64_t dense_sx_ = 0, dense_sy_ = 0;
   uint64_t id_ = 0;  // unique per grid built in this process (copies share it): density_index's cache key
+  // The map's inverse and translation (NanoVDB's mInvMatD, mVecD), kept where its off-diagonal entries
+  // are all zero (a scale and a translation, as the volume files have). NanoVDB computes row r as
+  // fma(x, m[3r], fma(y, m[3r+1], z m[3r+2])); with two of the three products exact signed zeros, the
+  // same sums in plain arithmetic are the same number without the library's fma calls (the build targets
+  // baseline x86-64, where std::fma is a call). They can differ only in the sign of a zero where the
+  // diagonal product underflows; the trilinear lookups take p - floor(p), +0 for either zero, so every
+  // density is the same bit for bit (issue 12; tests/media/density_grid_test.cpp).
+  bool axis_aligned_ = false;
+  double inv_mat_[9] = {}, vec_[3] = {};
 };
 
 // ---- inline implementation -------------------------------------------------------------------

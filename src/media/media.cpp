@@ -9,8 +9,10 @@ namespace nimbus {
 
 namespace {
 
-// Grid-world point of a vdb shape: undo translate, then scale.
-Vec3 vdb_grid_world(const VdbShape& v, const Vec3& p) { return (p - v.translate) / v.scale; }
+// Grid-world point of a vdb shape: undo translate, then scale (x / 1 is x: no divisions at scale 1).
+Vec3 vdb_grid_world(const VdbShape& v, const Vec3& p) {
+  return v.scale == 1.0 ? p - v.translate : (p - v.translate) / v.scale;
+}
 
 const DensityGrid* grid_of(const Shape& s) {
   if (const auto* v = std::get_if<VdbShape>(&s)) return v->data.get();

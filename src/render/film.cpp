@@ -51,6 +51,18 @@ FilmState Film::state(int spp) const {
   return st;
 }
 
+FilmState Film::take_state(int spp) && {
+  FilmState st;
+  st.width = width_;
+  st.height = height_;
+  st.spp = spp;
+  for (Layer& l : layers_) st.layers.push_back({l.name, l.channels, l.fraction_bits, std::move(l.sum)});
+  st.counts = std::move(count_);
+  layers_.clear();
+  count_.clear();
+  return st;
+}
+
 void Film::restore(const FilmState& st) {
   if (st.width != width_ || st.height != height_)
     throw Error(fmt::format("resume data: the image is {}x{}, the render {}x{}", st.width, st.height, width_,

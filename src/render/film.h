@@ -106,6 +106,9 @@ class Film {
 
   // The exact state (every layer's sums, the sample counts), to stop a render and resume it bit for bit.
   FilmState state(int spp) const;
+  // The same, its sums moved out rather than copied (the film is left with no layers or counts): for the
+  // end of a render, where the film is read no more.
+  FilmState take_state(int spp) &&;
   // Restores a state taken from a film with the same size and layers; throws nimbus::Error otherwise.
   void restore(const FilmState& state);
 

@@ -462,7 +462,6 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
     result.image.display_height = scene.camera.height;
   }
   if (options.deep_samples > 0 && done == settings.spp) result.deep = assemble_deep(W, H, deep_pixels);
-  if (options.deep_samples == 0) result.state = film.state(done);
   result.nonfinite_samples = pc.nonfinite;
   result.seconds = seconds_since(start);
   result.settings = resolved_block(settings, *integrator);
@@ -472,6 +471,7 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
     result.transient = result.image;
     result.transient.channels = time_film->resolve(film);
   }
+  if (options.deep_samples == 0) result.state = std::move(film).take_state(done);  // the film's last use
   if (options.region)
     result.metadata.emplace_back("nimbus/region",
                                  fmt::format("{},{},{},{}", window.x0, window.y0, window.x1, window.y1));

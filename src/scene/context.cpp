@@ -15,6 +15,7 @@ SceneContext::SceneContext(const Scene& scene, int majorant_resolution, bool glo
       if (env->map) env_map = env->map;  // the parser allows one image per scene
     } else {
       lights.push_back(l);
+      light_constants.push_back(nimbus::light_constants(l));
     }
   }
 }

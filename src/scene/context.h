@@ -12,6 +12,7 @@
 #include "nimbus/scene.h"
 #include "scene/camera.h"
 #include "scene/env_map.h"
+#include "scene/lights.h"
 #include "scene/surfaces.h"
 
 namespace nimbus {
@@ -24,8 +25,9 @@ struct SceneContext {
       analytic;  // active when every medium is a constant-density sphere or box (media/analytic_media.h)
   SceneSurfaces surfaces;
   PinholeCamera camera;
-  std::vector<Light> lights;  // every light but the environment (sampled by NEE)
-  Rgb environment{0.0};       // sum of constant environment lights' radiance
+  std::vector<Light> lights;                    // every light but the environment (sampled by NEE)
+  std::vector<LightConstants> light_constants;  // per light: what sample_light needs from it alone
+  Rgb environment{0.0};                         // sum of constant environment lights' radiance
   bool has_environment = false;
   std::shared_ptr<const EnvMap> env_map;  // the environment image, if any (scene/env_map.h)
 

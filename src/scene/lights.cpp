@@ -10,7 +10,23 @@ Rgb directional_disc_radiance(const DirectionalLight& light) {
   return light.irradiance / (kPi * s * s);
 }
 
+LightConstants light_constants(const Light& light) {
+  LightConstants k;
+  if (const auto* d = std::get_if<DirectionalLight>(&light); d && d->angular_diameter_deg > 0.0) {
+    // Uniform in the cone of the disc: weight = L / pdf = L * 2 pi (1 - cos r).
+    const double radius = 0.5 * d->angular_diameter_deg * kPi / 180.0;
+    k.cos_max = std::cos(radius);
+    k.disc_weight = directional_disc_radiance(*d) * (2.0 * kPi * (1.0 - k.cos_max));
+  }
+  return k;
+}
+
 bool sample_light(const Light& light, const Vec3& p, double u1, double u2, LightSample* out) {
+  return sample_light(light, light_constants(light), p, u1, u2, out);
+}
+
+bool sample_light(const Light& light, const LightConstants& k, const Vec3& p, double u1, double u2,
+                  LightSample* out) {
   if (const auto* d = std::get_if<DirectionalLight>(&light)) {
     const Vec3 to_light = -d->direction;
     out->distance = std::numeric_limits<double>::infinity();
@@ -19,12 +35,10 @@ bool sample_light(const Light& light, const Vec3& p, double u1, double u2, Light
       out->weight = d->irradiance;
       return true;
     }
-    // Uniform in the cone of the disc: weight = L / pdf = L * 2 pi (1 - cos r).
-    const double radius = 0.5 * d->angular_diameter_deg * kPi / 180.0;
-    const double cos_max = std::cos(radius);
-    const double cos_theta = 1.0 - u1 * (1.0 - cos_max);
+    // Uniform in the cone of the disc (light_constants).
+    const double cos_theta = 1.0 - u1 * (1.0 - k.cos_max);
     out->wi = spherical_direction(cos_theta, 2.0 * kPi * u2, to_light);
-    out->weight = directional_disc_radiance(*d) * (2.0 * kPi * (1.0 - cos_max));
+    out->weight = k.disc_weight;
     return true;
   }
   if (const auto* pt = std::get_if<PointLight>(&light)) {

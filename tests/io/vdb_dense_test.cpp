@@ -90,6 +90,34 @@ TEST(VdbDense, SharedVolumesReadTheSameValuesAsTheTree) {
   }
 }
 
+// The inline world -> index map of an axis-aligned grid (DensityGrid::world_to_index) against NanoVDB's
+// worldToIndex: the same numbers (== also takes -0.0 for 0.0, the one difference allowed), and the same
+// density bits, at random world points of the shared volumes and at the map's own translation.
+TEST(VdbDense, AxisAlignedWorldToIndexIsNanoVdbs) {
+  for (const char* name : {test::kCloud, test::kSmoke}) {
+    NIMBUS_REQUIRE_FILE(test::shared_volume(name));
+    const DensityGrid g = load_density_grid(test::shared_volume(name));
+    SCOPED_TRACE(name);
+    const auto& map = g.nano_grid().map();
+    const Bounds wb = g.world_bounds();
+    std::mt19937_64 rng(5);
+    std::uniform_real_distribution<double> u(-0.2, 1.2);
+    int failures = 0;
+    for (int i = 0; i < 100000; ++i) {
+      Vec3 w(wb.lo.x + u(rng) * (wb.hi.x - wb.lo.x), wb.lo.y + u(rng) * (wb.hi.y - wb.lo.y),
+             wb.lo.z + u(rng) * (wb.hi.z - wb.lo.z));
+      if (i == 0) w = Vec3(map.mVecD[0], map.mVecD[1], map.mVecD[2]);  // index (0, 0, 0): zeros
+      const auto q = g.nano_grid().worldToIndex(nanovdb::Vec3d(w.x, w.y, w.z));
+      const Vec3 expected(q[0], q[1], q[2]), p = g.world_to_index(w);
+      const DensityGrid tree = g.without_dense();
+      if (p != expected || !same_bits(g.density_index(p), g.density_index(expected)) ||
+          !same_bits(tree.density_index(p), tree.density_index(expected)))
+        if (++failures <= 5) ADD_FAILURE() << "at " << w << ": " << p << " against NanoVDB's " << expected;
+    }
+    EXPECT_EQ(failures, 0);
+  }
+}
+
 // Random values (some negative: clamped to 0 in the copy as in the tree), an inactive non-zero leaf
 // value (read by both), an active tile (no leaf: the copy fills its block) and a background of -0.25
 // (negative, clamped) outside.

@@ -25,6 +25,37 @@ double reference_falloff(double cone_deg, double blend, double cos_a) {
   return x * x * (3.0 - 2.0 * x);
 }
 
+// A sun's disc: directions uniform in its cone (inside it, at the right mean cosine), weight its radiance
+// times the cone's solid angle (the irradiance, to O(r^2)), and the light's precomputed constants give
+// the same samples bit for bit.
+TEST(DirectionalLight, DiscSamplesFillTheConeAndTheConstantsChangeNoBit) {
+  DirectionalLight d;
+  d.direction = normalize(Vec3(-0.75, -0.3, -0.55));
+  d.irradiance = Rgb(3.4, 3.0, 2.0);
+  d.angular_diameter_deg = 2.0;
+  const Light light(d);
+  const LightConstants k = light_constants(light);
+  const double r = kPi / 180.0, cos_max = std::cos(r);
+  EXPECT_EQ(k.cos_max, cos_max);
+  Rng rng(3, 1);
+  double mean_cos = 0.0;
+  constexpr int kN = 20000;
+  for (int n = 0; n < kN; ++n) {
+    const double u1 = rng.uniform(), u2 = rng.uniform();
+    LightSample a, b;
+    ASSERT_TRUE(sample_light(light, Vec3(1, 2, 3), u1, u2, &a));
+    ASSERT_TRUE(sample_light(light, k, Vec3(1, 2, 3), u1, u2, &b));
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_EQ(a.wi[c], b.wi[c]);
+      EXPECT_EQ(a.weight[c], b.weight[c]);
+      EXPECT_NEAR(a.weight[c], d.irradiance[c] * 2.0 * (1.0 - cos_max) / (std::sin(r) * std::sin(r)), 1e-12);
+    }
+    EXPECT_GE(dot(a.wi, -d.direction), cos_max - 1e-12);
+    mean_cos += dot(a.wi, -d.direction) / kN;
+  }
+  EXPECT_NEAR(mean_cos, 0.5 * (1.0 + cos_max), 2e-6);
+}
+
 TEST(SpotLight, FalloffIsOneInsideZeroOutsideAndSmoothstepAcrossTheBlend) {
   SpotLight s;
   s.cone_angle_deg = 60.0;
