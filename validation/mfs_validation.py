@@ -465,10 +465,7 @@ def size_frontier_text():
     head = [f"512 x 512, {dates[0]} to {dates[-1]}; load average {min(loads):.1f} to {max(loads):.1f} on 2 cores "
             f"while measured. Commits: {commits}. `pathtrace` uniform at 4, 16 and 64 spp (adaptive sampling and "
             f"`octave` not run at this size), 4 x 4-pixel bins as at 128 x 128.", ""]
-    text = "\n".join(head + speed_rows(res) + ["", "The frontiers (rel RMSE @ CPU seconds):", ""] +
-                     frontier_rows(res))
-    print(text)
-    write_between_markers("size512", text)
+    write_frontier_section("size512", head, res)
     return True
 
 
@@ -575,6 +572,15 @@ def frontier_rows(results):
     return lines
 
 
+def write_frontier_section(marker, head, res):
+    """The speed-up table and the frontiers of the results `res` under the lines `head`, printed and written
+    between the <!-- marker --> lines of render.md."""
+    text = "\n".join(head + speed_rows(res) + ["", "The frontiers (rel RMSE @ CPU seconds):", ""] +
+                     frontier_rows(res))
+    print(text)
+    write_between_markers(marker, text)
+
+
 def write_table(results):
     names = [n for n in suite() if n in results]
     res = {n: results[n] for n in names}
@@ -589,10 +595,7 @@ def write_table(results):
     head = [f"{r0['width']} x {r0['height']}, {dates[0]} to {dates[-1]}; load average {min(loads):.1f} to "
             f"{max(loads):.1f} on {r0['machine']['cpus']} cores while measured. Commits (the judge's and "
             f"octave's points; mfs's where it was measured again with --mfs-only): {per_scene}.", ""]
-    text = "\n".join(head + speed_rows(res) + ["", "The frontiers (rel RMSE @ CPU seconds):", ""] +
-                     frontier_rows(res))
-    print(text)
-    write_between_markers("table", text)
+    write_frontier_section("table", head, res)
 
 
 def options_table(results):
