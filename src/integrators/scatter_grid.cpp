@@ -339,9 +339,7 @@ void ScatterPhotons::trace(size_t j, Rng& rng, PhotonBatch& batch) const {
   int order = 0;  // wide scatters so far
   walk_photon(
       ctx, s.majorants ? *s.majorants : ctx.majorants, ph.x, ph.w, majorant_scale, rng, &batch.collisions,
-      [&](const Vec3& p) {
-        return s.exact_transport ? ctx.media.sigma_t(p)[c] : reduced_sigma_t(ctx.media, p, peak_fraction)[c];
-      },
+      [&](const Vec3& p) { return extinction(p)[c]; },
       [&](const Vec3& x, const Vec3& w, double t_end) {
         if (order >= first_order)
           deposit_flight(batch.tally.data(), block, grid, live, bands, x, w, t_end, power * weight, corners);
