@@ -28,6 +28,8 @@ class PinholeCamera {
     return normalize(forward_ + right_ * sx + up_ * sy);
   }
   const Vec3& origin() const { return origin_; }
+  int width() const { return width_; }
+  int height() const { return height_; }
   // The camera ray through image position (px, py).
   Ray generate_ray(double px, double py) const { return {origin_, direction(px, py)}; }
 

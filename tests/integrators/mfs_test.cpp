@@ -208,6 +208,8 @@ TEST(Mfs, OptionsAreValidatedStrictly) {
   EXPECT_THROW(parse(R"({"photons": 0})"), Error);
   EXPECT_THROW(parse(R"({"scatter_grid_resolution": 2})"), Error);
   EXPECT_NO_THROW(parse(R"({"scatter_grid_resolution": "auto"})"));
+  EXPECT_NO_THROW(parse(R"({"photons": "auto"})"));
+  EXPECT_THROW(parse(R"({"photons": "many"})"), Error);
   EXPECT_THROW(parse(R"({"scatter_grid_resolution": "fine"})"), Error);
   EXPECT_NO_THROW(validate_integrator_options(
       "octave", nlohmann::json::parse(R"({"octaves": 6, "a": 0.6, "b": 0.4, "c": 0.7})"), "t"));

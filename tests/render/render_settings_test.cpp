@@ -17,8 +17,8 @@ std::string meta(const RenderResult& r, const std::string& key) {
   return "";
 }
 
-Scene settings_sphere_scene(const std::string& integrator) {
-  return test::scene_from_json("{" + test::camera_json(8, 6) + R"(,
+Scene settings_sphere_scene(const std::string& integrator, int width = 8, int height = 6) {
+  return test::scene_from_json("{" + test::camera_json(width, height) + R"(,
     "media": [{"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1}, "sigma_s": 3.0, "sigma_a": 0.1,
                "phase": {"type": "hg", "g": 0.8}}],
     "lights": [{"type": "directional", "direction": [-1, 0.3, 0.2], "irradiance": 1.0},
@@ -46,6 +46,19 @@ TEST(RenderSettings, AutoChoicesAreResolvedInTheHeader) {
   ASSERT_EQ(r2.image.rgb.size(), r.image.rgb.size());
   EXPECT_EQ(std::memcmp(r2.image.rgb.data(), r.image.rgb.data(), r.image.rgb.size() * sizeof(float)), 0);
   EXPECT_EQ(r2.settings, r.settings);
+}
+
+// "auto" photons: 2^18 up to 128 x 128 pixels, then 2^18 sqrt(pixels / 128^2), from the whole image's pixels:
+// a crop of a 256 x 256 image traces 2^19, as the whole image would.
+TEST(RenderSettings, AutoPhotonsFollowTheWholeImagesPixels) {
+  const std::string mfs = R"({"type": "mfs", "spp": 1, "beam_photons": 1024, "scatter_grid_resolution": 8})";
+  EXPECT_EQ(render(settings_sphere_scene(mfs)).settings["photons"], 1 << 18);
+  RenderOptions o;
+  o.region = Region{100, 100, 102, 101};
+  const RenderResult crop = render(settings_sphere_scene(mfs, 256, 256), o);
+  EXPECT_EQ(crop.settings["photons"], 1 << 19);
+  EXPECT_EQ(render(settings_sphere_scene(R"({"type": "mfs", "photons": "auto"})", 4, 4)).settings["photons"],
+            1 << 18);
 }
 
 TEST(RenderSettings, OverridesAreWhatTheHeaderSays) {
