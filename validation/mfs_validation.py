@@ -432,7 +432,7 @@ def size_study():
 
 
 SIZE_RESULTS = os.path.join(DOCS, "render_512_results.json")
-REF_SPP_512 = {"disney_cloud": 512, "sphere_r10_a0.99_hg0.85_front": 2048, "sphere_r2_a0.99_hg0.85_side": 2048}
+REF_SPP_512 = {"disney_cloud": 512, "sphere_r10_a0.99_hg0.85_front": 2048, "sphere_r2_a0.99_hg0.85_side": 8192}
 
 
 def size_frontier(names, ref_spp):
@@ -447,10 +447,49 @@ def size_frontier(names, ref_spp):
         spp = int(ref_spp.get(name, REF_SPP_512.get(name, 2048)))
         r = frontier(f"{name}_512x512", sc, base, spp, mfs_spp=[1, 4], octave_spp=[], pt_spp=[4, 16, 64],
                      pt_noise=[])
+        r["bins"] = bin_sizes(f"{name}_512x512", spp, r)
         r["commit"], r["machine"] = commit_id(), machine_state()
         results[name] = r
         json.dump(results, open(SIZE_RESULTS, "w"), indent=1, sort_keys=True)
     size_frontier_text()
+
+
+def bin_sizes(tag, ref_spp, r, sizes=(4, 8, 16)):
+    """`mfs` at 1 spp against path tracing with larger bins (nimbus compare --bin B): `mfs`'s error with the
+    reference's noise removed, path tracing's c = rel RMSE^2 x spp from the reference's two halves (var(a - b) =
+    2 var(half)), its spp to that error and the CPU speed-up through the frontier's time fit."""
+    ref = os.path.join(REFS, f"{tag}_pt{ref_spp}")
+    mfs = os.path.join(TMP, f"{tag}_mfs1.exr")
+    m1 = next(m for m in r["mfs"] if m["spp"] == 1)
+    out = []
+    for b in sizes:
+        def rel(a, c):
+            p = subprocess.run([NIMBUS, "compare", a, c, "--bin", str(b), "--min-ref", "0.05", "--json"], check=True,
+                               capture_output=True, text=True)
+            return json.loads(p.stdout)["rel_rmse"]
+        half = rel(ref + "_a.exr", ref + "_b.exr") / math.sqrt(2)  # one half's noise
+        noise = half / math.sqrt(2)  # the merged reference's
+        c2 = half ** 2 * (ref_spp // 2)
+        e = math.sqrt(max(rel(mfs, ref + ".exr") ** 2 - noise ** 2, 1e-12))
+        spp = c2 / e ** 2
+        t = r["fit"]["t0_cpu_s"] + r["fit"]["k_cpu_s"] * spp
+        out.append({"bin": b, "mfs_error": e, "reference_noise": noise, "c2": c2, "pathtrace_spp": spp,
+                    "speedup_cpu_s": t / m1["cpu_s"]})
+    return out
+
+
+def bin_rows(res):
+    """The table of bin_sizes per scene (scenes as columns)."""
+    names = [n for n in res if res[n].get("bins")]
+    if not names:
+        return []
+    lines = ["| bins | " + " | ".join(f"{n}: `mfs` error, pt spp, speed-up" for n in names) + " |",
+             "|---|" + "---|" * len(names)]
+    for i, row in enumerate(res[names[0]]["bins"]):
+        cells = [res[n]["bins"][i] for n in names]
+        lines.append(f"| {row['bin']} x {row['bin']} | " + " | ".join(
+            f"{c['mfs_error']:.1%}, {c['pathtrace_spp']:.0f}, {c['speedup_cpu_s']:.1f}x" for c in cells) + " |")
+    return lines
 
 
 def size_frontier_text():
@@ -466,6 +505,13 @@ def size_frontier_text():
             f"while measured. Commits: {commits}. `pathtrace` uniform at 4, 16 and 64 spp (adaptive sampling and "
             f"`octave` not run at this size), 4 x 4-pixel bins as at 128 x 128.", ""]
     write_frontier_section("size512", head, res)
+    bins = bin_rows(res)
+    if bins:
+        text = "\n".join(["`mfs` at 1 spp by bin size (`nimbus compare --bin B --min-ref 0.05`; path tracing's c "
+                          "from the references' two halves; the reference's noise removed from `mfs`'s error; CPU "
+                          "times of the table above):", ""] + bins)
+        print(text)
+        write_between_markers("size512bins", text)
     return True
 
 
