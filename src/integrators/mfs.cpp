@@ -240,11 +240,12 @@ Rgb MfsIntegrator::trace(const Ray& ray, Rng& rng, CameraSample* sample, int bou
   Rgb direct(0.0);
   march_growing(
       ctx_.majorants, o, d, hit.t, s_.tau_step, jitter,
-      // Steps of tau_step (1 + step_growth tau_red), fixed in the cells where a medium may emit (eq. D13):
-      // growing steps would sample the emission's spatial variation, which no blur smooths, too coarsely.
+      // Steps of tau_step (1 + step_growth tau_red); fixed steps of at most kEmissionStep where a medium may
+      // emit (eq. D13: growing steps would sample the emission's variation, which no blur smooths, too coarsely).
       [&](double t0, double t1) {
-        const bool emits = ctx_.majorants.may_emit_at(o + d * (0.5 * (t0 + t1)));
-        return emits ? 1.0 : 1.0 + s_.step_growth * max_component(cam.tau_red);
+        return ctx_.majorants.may_emit_at(o + d * (0.5 * (t0 + t1)))
+                   ? std::min(1.0, kEmissionStep / s_.tau_step)
+                   : 1.0 + s_.step_growth * max_component(cam.tau_red);
       },
       [&](const Vec3& p, double t, double dt) {
         ++mfs_march_steps;

@@ -29,8 +29,8 @@
 //
 // | field                     | type                          | default   | meaning                               |
 // |---------------------------|-------------------------------|-----------|---------------------------------------|
-// | `tau_step`                | number in [1e-4, 100]         | 0.1       | optical depth per march step (against the majorant) |
-// | `step_growth`             | number in [0, 100]            | 3         | steps of tau_step (1 + step_growth tau_red), tau_red the camera-side reduced depth; fixed steps in the majorant cells where a medium may emit |
+// | `tau_step`                | number in [1e-4, 100]         | 0.2       | optical depth per march step (against the majorant) |
+// | `step_growth`             | number in [0, 100]            | 3         | steps of tau_step (1 + step_growth tau_red), tau_red the camera-side reduced depth; fixed steps of min(tau_step, 0.1) in the majorant cells where a medium may emit |
 // | `light_path`              | "forward" or "beer_lambert"   | "forward" | the light reaches the first wide scatter through peak scatters (reduced extinction), or unscattered only (the seed paper) |
 // | `propagator`              | "gsa" or "gaussian"           | "gsa"     | the peak's own moments in the small-angle propagator, or a Gaussian stand-in with the same theta2 |
 // | `peak_fraction`           | "auto" or [0, 0.99]           | "auto"    | f, the part of each phase function carried as a forward peak ("auto": g^2 per medium) |
@@ -74,8 +74,13 @@ enum class Propagator { gsa, gaussian };
 enum class PhotonTransport { exact, similarity };
 enum class ForwardSide { camera, light };
 
+// The camera march's step in the majorant cells where a medium may emit: at most this optical depth (and
+// tau_step where that is finer). The emission's spatial variation is not blurred by the propagator, so it
+// needs the steps the old default of tau_step (0.1) gave it (docs/benchmarks.md, issue 12).
+inline constexpr double kEmissionStep = 0.1;
+
 struct MfsSettings {
-  double tau_step = 0.1;
+  double tau_step = 0.2;
   double step_growth = 3.0;
   LightPath light_path = LightPath::forward;
   Propagator propagator = Propagator::gsa;

@@ -98,14 +98,15 @@ void march(const MajorantGrid& grid, const Vec3& o, const Vec3& d, double tmax, 
 }
 
 // The same with steps that may grow along the ray: each majorant cell's segment (t0, t1) is cut into
-// steps of at most tau_step * scale(t0, t1) optical depth, scale (>= 1) asked at the start of every cell
-// (`mfs`: the blur and the attenuation grow with depth, so deeper light needs fewer samples; seed sec. 1).
+// steps of at most tau_step * scale(t0, t1) optical depth, scale (> 0) asked at the start of every cell
+// (`mfs`: the blur and the attenuation grow with depth, so deeper light needs fewer samples; seed sec. 1;
+// and cells that emit take steps of their own size).
 template <typename Scale, typename F>
 void march_growing(const MajorantGrid& grid, const Vec3& o, const Vec3& d, double tmax, double tau_step,
                    double offset, Scale&& scale, F&& on_step) {
   grid.traverse(o, d, 0.0, tmax, [&](double t0, double t1, double maj) {
     if (maj <= 0.0) return true;
-    const int n = std::max(1, int(std::ceil((t1 - t0) * maj / (tau_step * std::max(1.0, scale(t0, t1))))));
+    const int n = std::max(1, int(std::ceil((t1 - t0) * maj / (tau_step * scale(t0, t1)))));
     const double dt = (t1 - t0) / n;
     for (int k = 0; k < n; ++k) {
       const double t = t0 + (k + offset) * dt;

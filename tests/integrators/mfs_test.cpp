@@ -611,8 +611,9 @@ TEST(Mfs, GrowingStepsMatchFixedSteps) {
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(a[c], b[c], 0.01 * b[c]) << c;
 }
 
-// Where a medium may emit, the steps do not grow (eq. D13): an emitting sphere renders bit for bit as with
-// fixed steps, while the same sphere without emission does not (its steps grow).
+// Where a medium may emit, the steps do not grow and are at most kEmissionStep (eq. D13): an emitting sphere
+// renders bit for bit as with fixed steps (and, at the default tau_step, as with fixed steps of
+// kEmissionStep), while the same sphere without emission does not (its steps grow).
 TEST(Mfs, EmittingCellsMarchAtFixedSteps) {
   for (const char* emission : {R"(, "emission": 0.5)", ""}) {
     Scene scene = test::scene_from_json("{" + test::camera_json(16, 16, 40.0) + R"(,
@@ -628,6 +629,13 @@ TEST(Mfs, EmittingCellsMarchAtFixedSteps) {
     const Image fixed = render(scene, RenderOptions{}).image;
     ASSERT_GT(image_mean(fixed)[0], 0.0);
     EXPECT_EQ(grown.rgb == fixed.rgb, *emission != '\0') << emission;
+    // The defaults (tau_step 0.2) march emitting cells at kEmissionStep (0.1): as fixed steps of 0.1.
+    scene.integrator.options = {{"photons", 4096}, {"beam_photons", 1024}};  // few: only the steps matter
+    const Image defaults = render(scene, RenderOptions{}).image;
+    scene.integrator.options = {
+        {"photons", 4096}, {"beam_photons", 1024}, {"step_growth", 0.0}, {"tau_step", kEmissionStep}};
+    const Image fine = render(scene, RenderOptions{}).image;
+    EXPECT_EQ(defaults.rgb == fine.rgb, *emission != '\0') << emission;
   }
 }
 
