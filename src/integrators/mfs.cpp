@@ -139,7 +139,7 @@ int auto_scatter_grid_resolution(const SceneContext& ctx) {
 // photons costs c N of set-up and leaves a noise a / N in the error^2 beside mfs's bias b^2; the rest of the
 // render costs F (the march, growing with the pixels). (b^2 + a / N) (F + c N) is least at
 // N = sqrt(a F / (b^2 c)), so the count follows the square root of the pixels. Measured at 512 x 512
-// (docs/validation/render.md): 4 x 2^18 gives 0.70x error^2 x CPU on the Disney cloud and 0.56x on the
+// (docs/benchmarks.md, "Photons by image size"): 4 x 2^18 gives 0.70x error^2 x CPU on the Disney cloud and 0.56x on the
 // front-lit r = 10 sphere against 2^18. The full image's pixels, not the spp or a region's: a resumed,
 // cropped or sample-range render traces the same photons as the render in one go.
 int auto_photons(const PinholeCamera& camera) {
