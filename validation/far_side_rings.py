@@ -11,32 +11,26 @@ side (x > +0.3 r) and between. Renders already in --out are kept.
 
     nice validation/far_side_rings.py --out /tmp/rings --variant b0=beam_photons=0 --orders
 """
-import argparse, json, os, subprocess, sys
+import argparse, json, os, sys
 
 import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
-import exr_reader  # noqa: E402
 import mfs_validation as mv  # noqa: E402
+from cloud_edge import lum  # noqa: E402
 
 RINGS = ((0, 4), (4, 12), (12, 30), (30, 80), (80, 10000))  # pixels at 512 x 512
 
 
-def render(scene, base, block, out):
-    if os.path.exists(out):
-        return
-    path = os.path.join(base, f".rings_{os.getpid()}.json")
-    json.dump(dict(scene, integrator=block), open(path, "w"))
-    try:
-        subprocess.run([mv.NIMBUS, "render", path, "-o", out, "--quiet"], check=True)
-    finally:
-        os.remove(path)
+def render(scene, base, block, spp, out, seed):
+    """mfs_validation's render, unless `out` is already there."""
+    if not os.path.exists(out):
+        mv.render(scene, base, block, spp, out, seed=seed)
 
 
 def luminance(path):
-    c, _ = exr_reader.read_exr(path)
-    return (0.2126 * c["R"] + 0.7152 * c["G"] + 0.0722 * c["B"]).astype(float)
+    return lum(path).astype(float)
 
 
 def rings(image, ref, scale):
@@ -77,7 +71,7 @@ def main():
     sc = mv.sized(scene, args.res, args.res)
     tag = os.path.join(args.out, f"{args.scene}_{args.res}")
     ref_path = f"{tag}_pt.exr"
-    render(sc, base, {"type": "pathtrace", "spp": args.pt_spp, "seed": 7}, ref_path)
+    render(sc, base, {"type": "pathtrace"}, args.pt_spp, ref_path, 7)
     ref, scale = luminance(ref_path), args.res / 512.0
     print(f"rings (pixels at 512 x 512, scaled by {scale:g}): " + ", ".join(f"{a}-{b}" for a, b in RINGS))
     variants = [("defaults", {})]
@@ -86,15 +80,15 @@ def main():
         variants.append((t, {field: json.loads(value)}))
     for t, opts in variants:
         out = f"{tag}_mfs_{t}.exr"
-        render(sc, base, dict({"type": "mfs", "spp": 4, "seed": 1}, **opts), out)
+        render(sc, base, dict({"type": "mfs"}, **opts), 4, out, 1)
         show(f"mfs {t}", rings(luminance(out), ref, scale))
     if args.orders:
         for k in range(4):
             pt = f"{tag}_pt_K{k}.exr"
-            render(sc, base, {"type": "pathtrace", "spp": args.pt_spp, "seed": 7, "max_wide_scatters": k}, pt)
+            render(sc, base, {"type": "pathtrace", "max_wide_scatters": k}, args.pt_spp, pt, 7)
             for t, opts in variants:
                 out = f"{tag}_mfs_{t}_K{k}.exr"
-                render(sc, base, dict({"type": "mfs", "spp": 4, "seed": 1, "large_angle_scatters": k}, **opts), out)
+                render(sc, base, dict({"type": "mfs", "large_angle_scatters": k}, **opts), 4, out, 1)
                 show(f"K <= {k} mfs {t}", rings(luminance(out), luminance(pt), scale))
 
 

@@ -137,8 +137,8 @@ def reference(tag, scene, base, spp):
     return ref, compare(halves[0], halves[1])[1] / 2.0
 
 
-def compare(a, b):
-    r = subprocess.run([NIMBUS, "compare", a, b, "--bin", "4", "--min-ref", "0.05", "--json"],
+def compare(a, b, bin_size=4):
+    r = subprocess.run([NIMBUS, "compare", a, b, "--bin", str(bin_size), "--min-ref", "0.05", "--json"],
                        check=True, capture_output=True, text=True)
     j = json.loads(r.stdout)
     return j["mean_luminance_a"] / j["mean_luminance_b"] - 1.0, j["rel_rmse"], j["mean_luminance_b"]
@@ -463,14 +463,10 @@ def bin_sizes(tag, ref_spp, r, sizes=(4, 8, 16)):
     m1 = next(m for m in r["mfs"] if m["spp"] == 1)
     out = []
     for b in sizes:
-        def rel(a, c):
-            p = subprocess.run([NIMBUS, "compare", a, c, "--bin", str(b), "--min-ref", "0.05", "--json"], check=True,
-                               capture_output=True, text=True)
-            return json.loads(p.stdout)["rel_rmse"]
-        half = rel(ref + "_a.exr", ref + "_b.exr") / math.sqrt(2)  # one half's noise
+        half = compare(ref + "_a.exr", ref + "_b.exr", b)[1] / math.sqrt(2)  # one half's noise
         noise = half / math.sqrt(2)  # the merged reference's
         c2 = half ** 2 * (ref_spp // 2)
-        e = math.sqrt(max(rel(mfs, ref + ".exr") ** 2 - noise ** 2, 1e-12))
+        e = math.sqrt(max(compare(mfs, ref + ".exr", b)[1] ** 2 - noise ** 2, 1e-12))
         spp = c2 / e ** 2
         t = r["fit"]["t0_cpu_s"] + r["fit"]["k_cpu_s"] * spp
         out.append({"bin": b, "mfs_error": e, "reference_noise": noise, "c2": c2, "pathtrace_spp": spp,
