@@ -48,6 +48,7 @@ MfsSettings mfs_settings_from_json(const nlohmann::json& options, const std::str
   s.path_lengthening = o.boolean("path_lengthening", s.path_lengthening);
   s.filtered_lookups = o.boolean("filtered_lookups", s.filtered_lookups);
   s.source_blur = o.boolean("source_blur", s.source_blur);
+  s.camera_tilt = o.boolean("camera_tilt", s.camera_tilt);
   s.peak_toward_camera = o.boolean("peak_toward_camera", s.peak_toward_camera);
   s.exact_light_transmittance = o.boolean("exact_light_transmittance", s.exact_light_transmittance);
   s.shadow_map_resolution = int(o.integer("shadow_map_resolution", 8, 1024, s.shadow_map_resolution));
@@ -78,6 +79,7 @@ nlohmann::json to_json(const MfsSettings& s) {
                       {"path_lengthening", s.path_lengthening},
                       {"filtered_lookups", s.filtered_lookups},
                       {"source_blur", s.source_blur},
+                      {"camera_tilt", s.camera_tilt},
                       {"peak_toward_camera", s.peak_toward_camera},
                       {"exact_light_transmittance", s.exact_light_transmittance},
                       {"shadow_map_resolution", s.shadow_map_resolution}};
@@ -234,7 +236,6 @@ Rgb MfsIntegrator::trace(const Ray& ray, Rng& rng, CameraSample* sample, int bou
   CameraPath cam;  // from the camera to the current step: T_full, T_red, tau_p, theta_p, tau_red, m0..m2
   const double jitter = rng.uniform();
   MediumPoint mp;
-  const bool blur = s_.source_blur && !s_.light_side();  // forward_side "light" has no camera-side spread
   MarchRecorder layers(sample);  // direct: the lights' light that took at most one wide scatter
   const ShBasis y_out(-d, grid_ ? grid_->bands() : 1);  // the scatter grid's basis towards the camera
   Rgb direct(0.0);
@@ -256,9 +257,7 @@ Rgb MfsIntegrator::trace(const Ray& ray, Rng& rng, CameraSample* sample, int bou
         // Add what each medium scatters towards the camera at the sample point y = p.
         if (max_component(mp.sigma_s) > 0.0) {
           const CameraPoint y = cam.at(k, jitter, dt, s_.light_side(), s_.path_lengthening);
-          Sources src;  // via y.T_cam / y.T_full
-          add_sources(mp, p, d, y_out, t, y, cam, rng, !blur, true, &src);
-          if (blur) add_blurred_sources(p, d, y_out, t, y, cam, rng, &src);
+          const Sources src = step_sources(mp, p, d, y_out, t, y, cam, rng);  // via y.T_cam / y.T_full
           L_step = (y.T_cam * src.in_scatter + y.T_full * src.peak_scatter) * dt;
           L += L_step;
           direct += (y.T_cam * src.lights_scatter + y.T_full * src.peak_scatter) * dt;
@@ -287,6 +286,39 @@ Rgb MfsIntegrator::trace(const Ray& ray, Rng& rng, CameraSample* sample, int bou
   return L + L_end;
 }
 
+MfsIntegrator::Sources MfsIntegrator::step_sources(const MediumPoint& m, const Vec3& p, const Vec3& d,
+                                                   const ShBasis& y_out, double t, const CameraPoint& y,
+                                                   const CameraPath& cam, Rng& rng) const {
+  Sources src;
+  double residual = 1.0;
+  if (s_.light_side()) {  // forward_side "light" has no camera-side spread
+    add_sources(m, p, d, d, y_out, t, y, cam, rng, true, true, &src);
+  } else if (s_.source_blur) {
+    add_sources(m, p, d, d, y_out, t, y, cam, rng, false, true, &src);
+    add_blurred_sources(p, d, y_out, t, y, cam, rng, &src);
+  } else if (Vec3 d_s; s_.camera_tilt && tilt(p, d, t, cam, rng, &d_s, &residual)) {
+    CameraPoint y_s = y;  // the scattered light: the tilted direction and the residual spread
+    y_s.tau_p = y.tau_p * residual;
+    const ShBasis y_out_s(-d_s, grid_ ? grid_->bands() : 1);
+    add_sources(m, p, d, d_s, y_out_s, t, y_s, cam, rng, true, true, &src);
+  } else {
+    add_sources(m, p, d, d, y_out, t, y, cam, rng, true, true, &src);
+  }
+  return src;
+}
+
+bool MfsIntegrator::tilt(const Vec3& p, const Vec3& d, double t, const CameraPath& cam, Rng& rng, Vec3* d_s,
+                         double* residual) const {
+  const double sigma = cam.lateral_spread(t);
+  if (!(sigma > 0.0)) return false;
+  const double u1 = rng.uniform(), u2 = rng.uniform();  // in this order (argument order is unspecified)
+  const Vec3 u = lateral_offset(d, sigma, u1, u2);
+  const bool plus = ctx_.media.inside(p + u), minus = ctx_.media.inside(p - u);
+  if (plus == minus) return false;
+  *d_s = survivor_direction(cam, t, d, plus ? u : -u, residual);
+  return true;
+}
+
 void MfsIntegrator::add_blurred_sources(const Vec3& p, const Vec3& d, const ShBasis& y_out, double t,
                                         const CameraPoint& y, const CameraPath& cam, Rng& rng,
                                         Sources* out) const {
@@ -296,17 +328,17 @@ void MfsIntegrator::add_blurred_sources(const Vec3& p, const Vec3& d, const ShBa
   const Vec3 ps = p + lateral_offset(d, cam.lateral_spread(t), u1, u2);
   MediumPoint m;
   ctx_.media.eval(ps, &m);
-  add_sources(m, ps, d, y_out, t, y, cam, rng, true, false, out);
+  add_sources(m, ps, d, d, y_out, t, y, cam, rng, true, false, out);
 }
 
-void MfsIntegrator::add_sources(const MediumPoint& m, const Vec3& p, const Vec3& d, const ShBasis& y_out,
-                                double t, const CameraPoint& y, const CameraPath& cam, Rng& rng,
-                                bool scattered, bool peak, Sources* out) const {
+void MfsIntegrator::add_sources(const MediumPoint& m, const Vec3& p, const Vec3& d, const Vec3& d_s,
+                                const ShBasis& y_out, double t, const CameraPoint& y, const CameraPath& cam,
+                                Rng& rng, bool scattered, bool peak, Sources* out) const {
   std::optional<TrilinearStencil> st;
   if (shared_stencil_) st = grid_->node_grid().stencil(p);
   for (int i = 0; i < m.count; ++i) {
     if (max_component(m.sigma_s_i[i]) <= 0.0) continue;
-    const MediumRadiance Lm = medium_radiance(i, p, d, y_out, t, y, cam, rng, st ? &*st : nullptr);
+    const MediumRadiance Lm = medium_radiance(i, p, d, d_s, y_out, t, y, cam, rng, st ? &*st : nullptr);
     if (scattered) out->in_scatter += m.sigma_s_i[i] * Lm.L;
     if (peak) out->peak_scatter += m.sigma_s_i[i] * Lm.L_peak;
     if (scattered) out->lights_scatter += m.sigma_s_i[i] * Lm.L_lights;
@@ -314,12 +346,13 @@ void MfsIntegrator::add_sources(const MediumPoint& m, const Vec3& p, const Vec3&
 }
 
 MfsIntegrator::MediumRadiance MfsIntegrator::medium_radiance(int i, const Vec3& p, const Vec3& d,
-                                                             const ShBasis& y_out, double t,
+                                                             const Vec3& d_s, const ShBasis& y_out, double t,
                                                              const CameraPoint& y, const CameraPath& cam,
                                                              Rng& rng, const TrilinearStencil* st) const {
   const PhaseSplit& split = *splits_[i];
   const double f = f_[i];
   MediumRadiance out{Rgb(0.0), Rgb(0.0), Rgb(0.0)};
+  const bool tilted = !(d_s == d);
   // peak_toward_camera's tally holds the light sent towards the camera: used on rays from it only.
   const auto camera_ray = [&] {
     const Vec3 v = p - ctx_.camera.origin(), c = cross(v, d);
@@ -332,16 +365,17 @@ MfsIntegrator::MediumRadiance MfsIntegrator::medium_radiance(int i, const Vec3& 
       out.L += light_side_scatter(ls.weight, f, split, mu, beam.tau_ps, beam.T_wide);  // eq. D11
       return;
     }
-    const PhaseSplit::Angle a = PhaseSplit::angle(mu);  // once for both terms
-    if (s_.large_angle_scatters != 0)                   // eq. D7, first term
-      out.L += first_wide_scatter(ls.weight, f, split, a, y.tau_p, s_.light_blur ? beam.tau_ps : Rgb(0.0),
+    const PhaseSplit::Angle a = PhaseSplit::angle(mu);                              // once for both terms
+    const PhaseSplit::Angle a_s = tilted ? PhaseSplit::angle(dot(d_s, ls.wi)) : a;  // the scattered light's
+    if (s_.large_angle_scatters != 0)                                               // eq. D7, first term
+      out.L += first_wide_scatter(ls.weight, f, split, a_s, y.tau_p, s_.light_blur ? beam.tau_ps : Rgb(0.0),
                                   beam.T_wide);
     if (s_.forward_light_path() && beam.toward && camera_ray())  // the traced beam's P_peak to the camera
       out.L_peak += ls.weight * f * beam.peak_toward * beam.T_wide;
     else if (s_.forward_light_path())  // eq. D7, second term: to the camera with T_full
       out.L_peak += forward_peak(ls.weight, f, split, a, beam.tau_ps, beam.T_wide);
     else  // eq. D7b (beer_lambert)
-      out.L += forward_peak(ls.weight, f, split, a, y.tau_p, beam.T_light);
+      out.L += forward_peak(ls.weight, f, split, a_s, y.tau_p, beam.T_light);
   };
   // Sample every light once (u1, u2, in this order).
   for (size_t l = 0; l < ctx_.lights.size(); ++l) {

@@ -1,5 +1,5 @@
 // `mfs`: Tessendorf's multiple forward scattering (seed eq. 3 / corrected eq. 17, steady state) as a
-// march along the camera ray. The derivations, numbered D1 .. D13, are in docs/derivations.md; the
+// march along the camera ray. The derivations, numbered D1 .. D16, are in docs/derivations.md; the
 // estimators are free functions in integrators/mfs_estimators.h; design and accuracy in
 // docs/validation/render.md.
 //
@@ -18,6 +18,8 @@
 //    photon-traced scatter grid (integrators/scatter_grid.h), by Funk-Hecke with the wide part's moments
 //    blurred by the camera-side peak depth (D12), optionally pre-filtered over the camera-side lateral
 //    spread (D10).
+// Near a medium's side the scattered light's direction is tilted towards the medium, as the camera-side
+// peak-scattered paths that stay in it are (camera_tilt, D16).
 // Camera-side light is attenuated by the reduced extinction (times the 1 / cosh path lengthening, D5,
 // with path_lengthening). forward_side "light" (D11) instead spreads everything on the light's side and
 // takes the camera leg exactly. Light transmittances come from deep shadow maps (deterministic); the
@@ -47,6 +49,7 @@
 // | `path_lengthening`        | boolean                       | false     | the corrected kernel's 1 / cosh loss on paths lengthened by peak deflections |
 // | `filtered_lookups`        | boolean                       | false     | scatter grid read pre-filtered over the camera-side lateral spread |
 // | `source_blur`             | boolean                       | false     | the source (sigma_s times every scattered term) read at a point drawn from the camera-side lateral footprint (D10), so rays near a boundary gather partly outside the medium |
+// | `camera_tilt`             | boolean                       | true      | near a medium's side, the camera-bound light's direction is tilted towards the medium, as the peak-scattered paths that stayed in it are (D16; ignored with source_blur) |
 // | `peak_toward_camera`      | boolean                       | false     | the forward peak alone takes its angular factor from the beam grid's photons (their P_peak towards the camera) instead of peak_eff at the beam's mean-cosine depth (one medium only) |
 // | `exact_light_transmittance` | boolean                     | false     | T_light and T_wide to directional and point lights without the shadow maps: the chord in closed form for one constant-density sphere or box, else a march |
 // | `shadow_map_resolution`   | integer in [8, 1024]          | 64        | deep shadow map nodes along the longest axis |
@@ -98,6 +101,7 @@ struct MfsSettings {
   bool path_lengthening = false;
   bool filtered_lookups = false;
   bool source_blur = false;
+  bool camera_tilt = true;
   bool peak_toward_camera = false;
   bool exact_light_transmittance = false;
   int shadow_map_resolution = 64;
@@ -152,20 +156,30 @@ class MfsIntegrator final : public Integrator {
   struct Sources {
     Rgb in_scatter{0.0}, peak_scatter{0.0}, lights_scatter{0.0};
   };
-  // y_out: Y_lm(-d), the scatter grid's basis towards the camera, evaluated once per ray.
+  // d: the camera ray's direction (the forward peak alone leaves along -d); d_s: the direction whose
+  // reverse the scattered light (T_cam) leaves along (d, or camera_tilt's, eq. D16); y_out: Y_lm(-d_s),
+  // the scatter grid's basis towards the camera. y.tau_p is the scattered light's camera-side peak depth.
   // The photon grids' trilinear stencil at p is found once for both where they share a layout (st: null
   // where each finds its own).
-  void add_sources(const MediumPoint& m, const Vec3& p, const Vec3& d, const ShBasis& y_out, double t,
-                   const CameraPoint& y, const CameraPath& cam, Rng& rng, bool scattered, bool peak,
+  void add_sources(const MediumPoint& m, const Vec3& p, const Vec3& d, const Vec3& d_s, const ShBasis& y_out,
+                   double t, const CameraPoint& y, const CameraPath& cam, Rng& rng, bool scattered, bool peak,
                    Sources* out) const;
+  // Every source of one march step at p (eq. D7's sum): on the ray, or with source_blur (D14) or
+  // camera_tilt (D16).
+  Sources step_sources(const MediumPoint& m, const Vec3& p, const Vec3& d, const ShBasis& y_out, double t,
+                       const CameraPoint& y, const CameraPath& cam, Rng& rng) const;
+  // camera_tilt (eq. D16): whether exactly one of p +- u (u drawn from the lateral footprint of depth t) is
+  // in a medium; then d_s, the tilted direction, and residual, the share of tau_p left to the spread.
+  bool tilt(const Vec3& p, const Vec3& d, double t, const CameraPath& cam, Rng& rng, Vec3* d_s,
+            double* residual) const;
   // source_blur (eq. D14): T_cam's light read at a point of the lateral footprint around p, zero outside
   // the media (the forward peak alone stays on the ray: add_sources at p).
   void add_blurred_sources(const Vec3& p, const Vec3& d, const ShBasis& y_out, double t, const CameraPoint& y,
                            const CameraPath& cam, Rng& rng, Sources* out) const;
   // What medium i sends towards the camera from the sample point p (at distance t) of the march: one
   // sample of every light (eqs. D7, D11) and the scatter grid's higher orders (eq. D12).
-  MediumRadiance medium_radiance(int i, const Vec3& p, const Vec3& d, const ShBasis& y_out, double t,
-                                 const CameraPoint& y, const CameraPath& cam, Rng& rng,
+  MediumRadiance medium_radiance(int i, const Vec3& p, const Vec3& d, const Vec3& d_s, const ShBasis& y_out,
+                                 double t, const CameraPoint& y, const CameraPath& cam, Rng& rng,
                                  const TrilinearStencil* st) const;
   // Light l's peak-only beam at p for medium i: shadow maps, beam grid (eqs. D8, D9); an area light
   // marches to its sampled point ls instead of reading a map.

@@ -65,6 +65,19 @@ double CameraPath::lateral_spread(double t) const {
   return std::sqrt(std::max(0.0, t * t * m0 - 2.0 * t * m1 + m2));
 }
 
+Vec3 survivor_direction(const CameraPath& cam, double t, const Vec3& d, const Vec3& u, double* residual) {
+  // (u, delta) per component jointly Gaussian: var(u) = v (eq. D10), cov(u, delta) = c, var(delta) = m0,
+  // so E[delta | u] = (c / v) u and var(delta | u) = m0 - c^2 / v.
+  const double s = cam.lateral_spread(t), v = s * s, c = cam.offset_deflection_covariance(t),
+               m0 = cam.deflection_variance();
+  if (!(v > 0.0) || !(m0 > 0.0)) {
+    *residual = 1.0;
+    return d;
+  }
+  *residual = std::clamp(1.0 - c * c / (v * m0), 0.0, 1.0);
+  return normalize(d + u * (c / v));
+}
+
 Vec3 lateral_offset(const Vec3& d, double sigma, double u1, double u2) {
   if (!(sigma > 0.0)) return Vec3(0.0);
   const double r = sigma * std::sqrt(-2.0 * std::log(1.0 - u1)), phi = 2.0 * kPi * u2;

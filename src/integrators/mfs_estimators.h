@@ -56,7 +56,16 @@ struct CameraPath {
   void advance(const MfsExtinction& k, double t, double dt, double jitter);
   // Lateral standard deviation of the light that reaches the camera from depth t (eq. D10).
   double lateral_spread(double t) const;
+  // The covariance (per component) of that light's lateral offset and its direction's deflection, and
+  // the deflection's variance (eq. D16).
+  double offset_deflection_covariance(double t) const { return t * m0 - m1; }
+  double deflection_variance() const { return m0; }
 };
+
+// camera_tilt (eq. D16): the camera-bound light's mean direction (reversed: the camera ray's d, deflected)
+// given that its lateral offset at depth t is u (a draw of the footprint towards the side where the medium
+// is), and the share of the camera-side peak depth left to the spread about it.
+Vec3 survivor_direction(const CameraPath& cam, double t, const Vec3& d, const Vec3& u, double* residual);
 
 // A point of the lateral footprint around the camera ray (direction d) at standard deviation sigma per
 // component (eq. D10): a 2-D Gaussian offset perpendicular to d by Box-Muller from u1, u2 (eq. D14).

@@ -102,6 +102,12 @@ double SceneMedia::density(int i, const Vec3& p) const {
   return g->density_index(grid_index(s, *g, q));
 }
 
+bool SceneMedia::inside(const Vec3& p) const {
+  for (int i = 0; i < count(); ++i)
+    if (density(i, p) > 0.0) return true;
+  return false;
+}
+
 double SceneMedia::max_density(int i, const Bounds& box, bool exact) const {
   if (!medium_bounds_[i].overlaps(box)) return 0.0;
   const Shape& s = media_[i].shape;

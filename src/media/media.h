@@ -41,6 +41,8 @@ class SceneMedia {
   // DensityGrid::max_density_index_exact).
   double max_density(int i, const Bounds& box, bool exact = false) const;
   void eval(const Vec3& p, MediumPoint* out) const;
+  // Whether any medium has density > 0 at p.
+  bool inside(const Vec3& p) const;
   // Total extinction per channel at p.
   Rgb sigma_t(const Vec3& p) const;
   // Emission (media/emission.h): whether any medium emits, whether medium i may emit anywhere in the world

@@ -35,6 +35,28 @@ TEST(MfsEstimators, ExtinctionSplitSumsTheMedia) {  // eq. D2
   }
 }
 
+// eq. D16 on a path through a uniform medium that begins at z0 (empty before it): the offset and the
+// deflection accumulate var(u) = a L^3 / 3, cov = a L^2 / 2 and var(delta) = a L over the L crossed, so
+// E[delta | u] = 3 u / (2 L) and a quarter of the deflection's variance is left; without any peak depth
+// the direction is the ray's.
+TEST(MfsEstimators, SurvivorDirectionOnAUniformPath) {
+  const Vec3 d(0.0, 0.0, 1.0), u(0.02, -0.01, 0.0);
+  double residual = -1.0;
+  EXPECT_EQ(survivor_direction(CameraPath{}, 3.0, d, u, &residual), d);
+  EXPECT_EQ(residual, 1.0);
+  MfsExtinction k{Rgb(2.0), Rgb(1.5), Rgb(0.03), Rgb(0.5)};
+  CameraPath cam;
+  const double z0 = 1.25, dt = 0.001;
+  int n = 0;
+  for (double t = z0 + 0.5 * dt; n < 2000; t += dt, ++n) cam.advance(k, t, dt, 0.5);
+  const double L = n * dt;
+  const Vec3 got = survivor_direction(cam, z0 + L, d, u, &residual);
+  const Vec3 want = normalize(d + u * (1.5 / L));
+  EXPECT_NEAR(residual, 0.25, 1e-5);
+  for (int a = 0; a < 3; ++a) EXPECT_NEAR(got[a], want[a], 1e-7) << a;
+  EXPECT_NEAR(got.length(), 1.0, 1e-12);
+}
+
 TEST(MfsEstimators, CameraPathAccumulatesDepthsAndSpread) {  // eqs. D2, D10
   MfsExtinction k{Rgb(2.0), Rgb(1.5), Rgb(0.03), Rgb(0.5)};
   CameraPath cam;

@@ -75,6 +75,7 @@ TEST(Registry, SettingsRoundTripThroughJson) {
                                               {"path_lengthening", true},
                                               {"filtered_lookups", true},
                                               {"source_blur", true},
+                                              {"camera_tilt", false},
                                               {"peak_toward_camera", true},
                                               {"exact_light_transmittance", true},
                                               {"shadow_map_resolution", 32}});
@@ -90,7 +91,8 @@ TEST(Registry, DefaultsAreWrittenOut) {
   EXPECT_EQ(mfs["scatter_grid_resolution"], "auto");
   EXPECT_EQ(mfs["light_path"], "forward");
   EXPECT_EQ(mfs["photon_splat"], "trilinear");
-  EXPECT_EQ(mfs.size(), 21u);  // every option of the table in mfs.h
+  EXPECT_EQ(mfs["camera_tilt"], true);
+  EXPECT_EQ(mfs.size(), 22u);  // every option of the table in mfs.h
 }
 
 TEST(Registry, UnknownFieldsAndNamesAreErrors) {
