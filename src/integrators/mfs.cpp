@@ -235,6 +235,11 @@ Rgb MfsIntegrator::trace(const Ray& ray, Rng& rng, CameraSample* sample, int bou
   Rgb L(0.0);
   CameraPath cam;  // from the camera to the current step: T_full, T_red, tau_p, theta_p, tau_red, m0..m2
   const double jitter = rng.uniform();
+  std::optional<FootprintProbe> probe;  // camera_tilt's offsets (eq. D16)
+  if (s_.camera_tilt && !s_.source_blur && !s_.light_side()) {
+    const double u1 = rng.uniform(), u2 = rng.uniform();  // in this order (argument order is unspecified)
+    probe.emplace(d, u1, u2);
+  }
   MediumPoint mp;
   MarchRecorder layers(sample);  // direct: the lights' light that took at most one wide scatter
   const ShBasis y_out(-d, grid_ ? grid_->bands() : 1);  // the scatter grid's basis towards the camera
@@ -257,7 +262,7 @@ Rgb MfsIntegrator::trace(const Ray& ray, Rng& rng, CameraSample* sample, int bou
         // Add what each medium scatters towards the camera at the sample point y = p.
         if (max_component(mp.sigma_s) > 0.0) {
           const CameraPoint y = cam.at(k, jitter, dt, s_.light_side(), s_.path_lengthening);
-          const Sources src = step_sources(mp, p, d, y_out, t, y, cam, rng);  // via y.T_cam / y.T_full
+          const Sources src = step_sources(mp, p, d, y_out, t, y, cam, rng, probe ? &*probe : nullptr);
           L_step = (y.T_cam * src.in_scatter + y.T_full * src.peak_scatter) * dt;
           L += L_step;
           direct += (y.T_cam * src.lights_scatter + y.T_full * src.peak_scatter) * dt;
@@ -288,7 +293,8 @@ Rgb MfsIntegrator::trace(const Ray& ray, Rng& rng, CameraSample* sample, int bou
 
 MfsIntegrator::Sources MfsIntegrator::step_sources(const MediumPoint& m, const Vec3& p, const Vec3& d,
                                                    const ShBasis& y_out, double t, const CameraPoint& y,
-                                                   const CameraPath& cam, Rng& rng) const {
+                                                   const CameraPath& cam, Rng& rng,
+                                                   FootprintProbe* probe) const {
   Sources src;
   double residual = 1.0;
   if (s_.light_side()) {  // forward_side "light" has no camera-side spread
@@ -296,7 +302,7 @@ MfsIntegrator::Sources MfsIntegrator::step_sources(const MediumPoint& m, const V
   } else if (s_.source_blur) {
     add_sources(m, p, d, d, y_out, t, y, cam, rng, false, true, &src);
     add_blurred_sources(p, d, y_out, t, y, cam, rng, &src);
-  } else if (Vec3 d_s; s_.camera_tilt && tilt(p, d, t, cam, rng, &d_s, &residual)) {
+  } else if (Vec3 d_s; probe && tilt(p, d, t, cam, *probe, &d_s, &residual)) {
     CameraPoint y_s = y;  // the scattered light: the tilted direction and the residual spread
     y_s.tau_p = y.tau_p * residual;
     const ShBasis y_out_s(-d_s, grid_ ? grid_->bands() : 1);
@@ -307,12 +313,11 @@ MfsIntegrator::Sources MfsIntegrator::step_sources(const MediumPoint& m, const V
   return src;
 }
 
-bool MfsIntegrator::tilt(const Vec3& p, const Vec3& d, double t, const CameraPath& cam, Rng& rng, Vec3* d_s,
-                         double* residual) const {
+bool MfsIntegrator::tilt(const Vec3& p, const Vec3& d, double t, const CameraPath& cam, FootprintProbe& probe,
+                         Vec3* d_s, double* residual) const {
   const double sigma = cam.lateral_spread(t);
   if (!(sigma > 0.0)) return false;
-  const double u1 = rng.uniform(), u2 = rng.uniform();  // in this order (argument order is unspecified)
-  const Vec3 u = lateral_offset(d, sigma, u1, u2);
+  const Vec3 u = probe.next(sigma);
   const bool plus = ctx_.media.inside(p + u), minus = ctx_.media.inside(p - u);
   if (plus == minus) return false;
   *d_s = survivor_direction(cam, t, d, plus ? u : -u, residual);

@@ -166,11 +166,13 @@ class MfsIntegrator final : public Integrator {
                    Sources* out) const;
   // Every source of one march step at p (eq. D7's sum): on the ray, or with source_blur (D14) or
   // camera_tilt (D16).
+  // probe: the ray's camera_tilt offsets (null without camera_tilt).
   Sources step_sources(const MediumPoint& m, const Vec3& p, const Vec3& d, const ShBasis& y_out, double t,
-                       const CameraPoint& y, const CameraPath& cam, Rng& rng) const;
-  // camera_tilt (eq. D16): whether exactly one of p +- u (u drawn from the lateral footprint of depth t) is
-  // in a medium; then d_s, the tilted direction, and residual, the share of tau_p left to the spread.
-  bool tilt(const Vec3& p, const Vec3& d, double t, const CameraPath& cam, Rng& rng, Vec3* d_s,
+                       const CameraPoint& y, const CameraPath& cam, Rng& rng, FootprintProbe* probe) const;
+  // camera_tilt (eq. D16): whether exactly one of p +- u (u the probe's next point of the lateral footprint
+  // of depth t) is in a medium; then d_s, the tilted direction, and residual, the share of tau_p left to
+  // the spread.
+  bool tilt(const Vec3& p, const Vec3& d, double t, const CameraPath& cam, FootprintProbe& probe, Vec3* d_s,
             double* residual) const;
   // source_blur (eq. D14): T_cam's light read at a point of the lateral footprint around p, zero outside
   // the media (the forward peak alone stays on the ray: add_sources at p).

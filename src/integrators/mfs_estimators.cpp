@@ -2,6 +2,7 @@
 #include "integrators/mfs_estimators.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 namespace nimbus {
@@ -76,6 +77,44 @@ Vec3 survivor_direction(const CameraPath& cam, double t, const Vec3& d, const Ve
   }
   *residual = std::clamp(1.0 - c * c / (v * m0), 0.0, 1.0);
   return normalize(d + u * (c / v));
+}
+
+namespace {
+
+// The Rayleigh distribution's strata midpoints, sqrt(-2 ln(1 - (k + 1/2) / n)), scaled to mean square 2.
+std::array<double, FootprintProbe::kStrata> rayleigh_strata() {
+  std::array<double, FootprintProbe::kStrata> r{};
+  double m2 = 0.0;
+  for (int k = 0; k < FootprintProbe::kStrata; ++k) {
+    r[size_t(k)] = std::sqrt(-2.0 * std::log(1.0 - (k + 0.5) / FootprintProbe::kStrata));
+    m2 += r[size_t(k)] * r[size_t(k)] / FootprintProbe::kStrata;
+  }
+  for (double& x : r) x *= std::sqrt(2.0 / m2);
+  return r;
+}
+
+}  // namespace
+
+FootprintProbe::FootprintProbe(const Vec3& d, double u1, double u2) {
+  const Frame fr(d);
+  s_ = fr.s;
+  t_ = fr.t;
+  c_ = std::cos(2.0 * kPi * u1);
+  sn_ = std::sin(2.0 * kPi * u1);
+  k_ = std::min(kStrata - 1, int(u2 * kStrata));
+}
+
+Vec3 FootprintProbe::next(double sigma) {
+  static const std::array<double, kStrata> radius = rayleigh_strata();
+  static const double cg = std::cos(kPi * (3.0 - std::sqrt(5.0))),
+                      sg = std::sin(kPi * (3.0 - std::sqrt(5.0)));
+  const double r = sigma * radius[size_t(k_)];
+  const Vec3 u = s_ * (r * c_) + t_ * (r * sn_);
+  const double c = c_ * cg - sn_ * sg;  // the golden angle further
+  sn_ = sn_ * cg + c_ * sg;
+  c_ = c;
+  k_ = (k_ + 5) % kStrata;
+  return u;
 }
 
 Vec3 lateral_offset(const Vec3& d, double sigma, double u1, double u2) {

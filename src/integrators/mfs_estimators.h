@@ -62,6 +62,25 @@ struct CameraPath {
   double deflection_variance() const { return m0; }
 };
 
+// camera_tilt's offsets along one camera ray (eq. D16): points of the lateral footprint, a 2-D Gaussian
+// perpendicular to d, one per march step. The azimuth starts at random and turns by the golden angle at
+// each step; the radius runs through the midpoints of 16 equal-probability strata of the Rayleigh
+// distribution (scaled so that its mean square is exact) from a random start, in strides of 5. Each step's
+// offset has the footprint's azimuth and (stratified) radius, for one sincos per ray instead of a log and a
+// sincos per step.
+class FootprintProbe {
+ public:
+  static constexpr int kStrata = 16;
+  FootprintProbe(const Vec3& d, double u1, double u2);
+  // The next offset, at standard deviation sigma per component.
+  Vec3 next(double sigma);
+
+ private:
+  Vec3 s_, t_;     // the plane perpendicular to d
+  double c_, sn_;  // cos and sin of the current azimuth
+  int k_;          // the current radius stratum
+};
+
 // camera_tilt (eq. D16): the camera-bound light's mean direction (reversed: the camera ray's d, deflected)
 // given that its lateral offset at depth t is u (a draw of the footprint towards the side where the medium
 // is), and the share of the camera-side peak depth left to the spread about it.

@@ -57,6 +57,43 @@ TEST(MfsEstimators, SurvivorDirectionOnAUniformPath) {
   EXPECT_NEAR(got.length(), 1.0, 1e-12);
 }
 
+// camera_tilt's footprint offsets (eq. D16): any 16 consecutive offsets of one probe visit every radius
+// stratum once, so their mean square length is the footprint's 2 sigma^2 exactly, and each is
+// perpendicular to d; over random starts, one step's offset has mean 0 and variance sigma^2 along each
+// axis of the plane (within 4 standard errors of the sample).
+TEST(MfsEstimators, FootprintProbeHasTheFootprintsMoments) {
+  const Vec3 d = normalize(Vec3(0.3, -0.5, 0.8));
+  const double sigma = 0.5;
+  FootprintProbe probe(d, 0.37, 0.81);
+  for (int round = 0; round < 3; ++round) {
+    double m2 = 0.0;
+    for (int k = 0; k < FootprintProbe::kStrata; ++k) {
+      const Vec3 u = probe.next(sigma);
+      EXPECT_NEAR(dot(u, d), 0.0, 1e-12);
+      m2 += dot(u, u) / FootprintProbe::kStrata;
+    }
+    EXPECT_NEAR(m2, 2.0 * sigma * sigma, 1e-12) << round;
+  }
+  const Frame fr(d);
+  Rng rng(7, 0);
+  const int n = 40000;
+  double sx = 0.0, sy = 0.0, sxx = 0.0, syy = 0.0, sx4 = 0.0;
+  for (int i = 0; i < n; ++i) {
+    const double u1 = rng.uniform(), u2 = rng.uniform();
+    FootprintProbe p(d, u1, u2);
+    Vec3 u;
+    for (int k = 0; k < 4; ++k) u = p.next(sigma);  // the fourth step's offset
+    const double x = dot(u, fr.s), y = dot(u, fr.t);
+    sx += x, sy += y, sxx += x * x, syy += y * y, sx4 += x * x * x * x;
+  }
+  const double var_x = sxx / n, se_mean = std::sqrt(var_x / n);
+  const double se_var = std::sqrt((sx4 / n - var_x * var_x) / n);
+  EXPECT_NEAR(sx / n, 0.0, 4.0 * se_mean);
+  EXPECT_NEAR(sy / n, 0.0, 4.0 * se_mean);
+  EXPECT_NEAR(var_x, sigma * sigma, 4.0 * se_var);
+  EXPECT_NEAR(syy / n, sigma * sigma, 4.0 * se_var);
+}
+
 TEST(MfsEstimators, CameraPathAccumulatesDepthsAndSpread) {  // eqs. D2, D10
   MfsExtinction k{Rgb(2.0), Rgb(1.5), Rgb(0.03), Rgb(0.5)};
   CameraPath cam;
