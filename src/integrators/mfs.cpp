@@ -235,11 +235,7 @@ Rgb MfsIntegrator::trace(const Ray& ray, Rng& rng, CameraSample* sample, int bou
   Rgb L(0.0);
   CameraPath cam;  // from the camera to the current step: T_full, T_red, tau_p, theta_p, tau_red, m0..m2
   const double jitter = rng.uniform();
-  std::optional<FootprintProbe> probe;  // camera_tilt's offsets (eq. D16)
-  if (s_.camera_tilt && !s_.source_blur && !s_.light_side()) {
-    const double u1 = rng.uniform(), u2 = rng.uniform();  // in this order (argument order is unspecified)
-    probe.emplace(d, u1, u2);
-  }
+  std::optional<FootprintProbe> probe = footprint_probe(d, rng);  // camera_tilt's offsets (eq. D16)
   MediumPoint mp;
   MarchRecorder layers(sample);  // direct: the lights' light that took at most one wide scatter
   const ShBasis y_out(-d, grid_ ? grid_->bands() : 1);  // the scatter grid's basis towards the camera
@@ -311,6 +307,12 @@ MfsIntegrator::Sources MfsIntegrator::step_sources(const MediumPoint& m, const V
     add_sources(m, p, d, d, y_out, t, y, cam, rng, true, true, &src);
   }
   return src;
+}
+
+std::optional<FootprintProbe> MfsIntegrator::footprint_probe(const Vec3& d, Rng& rng) const {
+  if (!s_.camera_tilt || s_.source_blur || s_.light_side()) return std::nullopt;
+  const double u1 = rng.uniform(), u2 = rng.uniform();  // in this order (argument order is unspecified)
+  return FootprintProbe(d, u1, u2);
 }
 
 bool MfsIntegrator::tilt(const Vec3& p, const Vec3& d, double t, const CameraPath& cam, FootprintProbe& probe,

@@ -169,6 +169,9 @@ class MfsIntegrator final : public Integrator {
   // probe: the ray's camera_tilt offsets (null without camera_tilt).
   Sources step_sources(const MediumPoint& m, const Vec3& p, const Vec3& d, const ShBasis& y_out, double t,
                        const CameraPoint& y, const CameraPath& cam, Rng& rng, FootprintProbe* probe) const;
+  // camera_tilt's offsets for a ray along d (eq. D16; nullopt without camera_tilt, with source_blur and with
+  // forward_side "light").
+  std::optional<FootprintProbe> footprint_probe(const Vec3& d, Rng& rng) const;
   // camera_tilt (eq. D16): whether exactly one of p +- u (u the probe's next point of the lateral footprint
   // of depth t) is in a medium; then d_s, the tilted direction, and residual, the share of tau_p left to
   // the spread.
