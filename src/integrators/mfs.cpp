@@ -310,7 +310,7 @@ MfsIntegrator::Sources MfsIntegrator::step_sources(const MediumPoint& m, const V
 }
 
 std::optional<FootprintProbe> MfsIntegrator::footprint_probe(const Vec3& d, Rng& rng) const {
-  if (!s_.camera_tilt || s_.source_blur || s_.light_side()) return std::nullopt;
+  if (!s_.camera_tilt || s_.source_blur || s_.light_side() || !s_.forward_light_path()) return std::nullopt;
   const double u1 = rng.uniform(), u2 = rng.uniform();  // in this order (argument order is unspecified)
   return FootprintProbe(d, u1, u2);
 }
@@ -382,7 +382,7 @@ MfsIntegrator::MediumRadiance MfsIntegrator::medium_radiance(int i, const Vec3& 
     else if (s_.forward_light_path())  // eq. D7, second term: to the camera with T_full
       out.L_peak += forward_peak(ls.weight, f, split, a, beam.tau_ps, beam.T_wide);
     else  // eq. D7b (beer_lambert)
-      out.L += forward_peak(ls.weight, f, split, a_s, y.tau_p, beam.T_light);
+      out.L += forward_peak(ls.weight, f, split, a, y.tau_p, beam.T_light);
   };
   // Sample every light once (u1, u2, in this order).
   for (size_t l = 0; l < ctx_.lights.size(); ++l) {

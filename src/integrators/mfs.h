@@ -49,7 +49,7 @@
 // | `path_lengthening`        | boolean                       | false     | the corrected kernel's 1 / cosh loss on paths lengthened by peak deflections |
 // | `filtered_lookups`        | boolean                       | false     | scatter grid read pre-filtered over the camera-side lateral spread |
 // | `source_blur`             | boolean                       | false     | the source (sigma_s times every scattered term) read at a point drawn from the camera-side lateral footprint (D10), so rays near a boundary gather partly outside the medium |
-// | `camera_tilt`             | boolean                       | true      | near a medium's side, the camera-bound light's direction is tilted towards the medium, as the peak-scattered paths that stayed in it are (D16; ignored with source_blur) |
+// | `camera_tilt`             | boolean                       | true      | near a medium's side, the camera-bound light's direction is tilted towards the medium, as the peak-scattered paths that stayed in it are (D16; ignored with source_blur, forward_side "light" and light_path "beer_lambert") |
 // | `peak_toward_camera`      | boolean                       | false     | the forward peak alone takes its angular factor from the beam grid's photons (their P_peak towards the camera) instead of peak_eff at the beam's mean-cosine depth (one medium only) |
 // | `exact_light_transmittance` | boolean                     | false     | T_light and T_wide to directional and point lights without the shadow maps: the chord in closed form for one constant-density sphere or box, else a march |
 // | `shadow_map_resolution`   | integer in [8, 1024]          | 64        | deep shadow map nodes along the longest axis |
@@ -169,8 +169,8 @@ class MfsIntegrator final : public Integrator {
   // probe: the ray's camera_tilt offsets (null without camera_tilt).
   Sources step_sources(const MediumPoint& m, const Vec3& p, const Vec3& d, const ShBasis& y_out, double t,
                        const CameraPoint& y, const CameraPath& cam, Rng& rng, FootprintProbe* probe) const;
-  // camera_tilt's offsets for a ray along d (eq. D16; nullopt without camera_tilt, with source_blur and with
-  // forward_side "light").
+  // camera_tilt's offsets for a ray along d (eq. D16; nullopt without camera_tilt, with source_blur, with
+  // forward_side "light" and with light_path "beer_lambert").
   std::optional<FootprintProbe> footprint_probe(const Vec3& d, Rng& rng) const;
   // camera_tilt (eq. D16): whether exactly one of p +- u (u the probe's next point of the lateral footprint
   // of depth t) is in a medium; then d_s, the tilted direction, and residual, the share of tau_p left to

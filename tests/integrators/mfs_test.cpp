@@ -754,6 +754,33 @@ TEST(Mfs, CameraTiltBalancesTheLitAndFarHalves) {
   EXPECT_LT(std::abs(tilted - ref), std::abs(straight - ref) - 0.02 * ref);
 }
 
+// camera_tilt stays off with light_path "beer_lambert" (its first peak scatter of unscattered light is a
+// sharp lobe that the tilt's Gaussian picture misplaces), forward_side "light" (no camera-side spread) and
+// source_blur: the images are those without it, bit for bit; with the defaults it changes them.
+TEST(Mfs, CameraTiltIsOffWhereItDoesNotApply) {
+  Scene scene = test::scene_from_json("{" + test::camera_json(12, 12, 40.0) + R"(,
+    "media": [{"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1}, "sigma_s": 3.0, "sigma_a": 0.03,
+               "phase": {"type": "hg", "g": 0.85}}],
+    "lights": [{"type": "directional", "direction": [-1, 0.1, 0.05], "irradiance": 1.0}]})");
+  scene.integrator.type = "mfs";
+  scene.integrator.spp = 2;
+  const std::vector<nlohmann::json> off = {
+      {{"light_path", "beer_lambert"}}, {{"forward_side", "light"}}, {{"source_blur", true}}};
+  for (const nlohmann::json& o : off) {
+    nlohmann::json without = o;
+    without["camera_tilt"] = false;
+    scene.integrator.options = o;
+    const Image a = render(scene, RenderOptions{}).image;
+    scene.integrator.options = without;
+    const Image b = render(scene, RenderOptions{}).image;
+    EXPECT_EQ(a.rgb, b.rgb) << o.dump();
+  }
+  scene.integrator.options = nlohmann::json::object();
+  const Image a = render(scene, RenderOptions{}).image;
+  scene.integrator.options = {{"camera_tilt", false}};
+  EXPECT_NE(a.rgb, render(scene, RenderOptions{}).image.rgb);
+}
+
 // A point light (inside the media's bounding sphere, so photons leave it in every direction) and
 // chromatic coefficients (one photon pass per channel): isotropic scattering, all orders, against the
 // path tracer.
