@@ -12,8 +12,9 @@ CMAKE_FLAGS ?=
 FUZZ_SECONDS ?= 600
 # Left out of the sanitizer run (docs/reliability.md): 30 s to 2 min each under ASan, and their code
 # paths are the ones the other fast tests (Mfs.* among them) already take there (the emitting-cell mask:
-# Emission.*; source_blur: one medium lookup at an offset point, its offset tested by MfsEstimators.LateralOffset*).
-ASAN_SKIP ?= ^Stress\.ExtremeScenesHaveNoNonFiniteSamples$$|^Determinism\.EveryIntegratorIsBitIdenticalForAnyThreadCount$$|^Mfs\.(WhiteFurnaceWithAllOrders|FilteredLookupsOfTheScatterGrid|GrowingStepsMatchFixedSteps|BitIdenticalForAnyThreadCount|MoreWideScattersAddLight|IsotropicMediumMatchesPathTracerOrderByOrder|BeamGridReproducesTheStraightBeamWithoutDeflection|EmittingCellsMarchAtFixedSteps|SourceBlurKeepsASlabAndDarkensARim)$$
+# Emission.*; source_blur: one medium lookup at an offset point, its offset tested by MfsEstimators.LateralOffset*;
+# camera_tilt: every other Mfs test takes it, its probe tested by MfsEstimators.FootprintProbe*).
+ASAN_SKIP ?= ^Stress\.ExtremeScenesHaveNoNonFiniteSamples$$|^Determinism\.EveryIntegratorIsBitIdenticalForAnyThreadCount$$|^Mfs\.(WhiteFurnaceWithAllOrders|FilteredLookupsOfTheScatterGrid|GrowingStepsMatchFixedSteps|BitIdenticalForAnyThreadCount|MoreWideScattersAddLight|IsotropicMediumMatchesPathTracerOrderByOrder|BeamGridReproducesTheStraightBeamWithoutDeflection|EmittingCellsMarchAtFixedSteps|SourceBlurKeepsASlabAndDarkensARim|CameraTiltBalancesTheLitAndFarHalves)$$
 
 .PHONY: all deps configure build python demo test test-fast asan bench clean fuzz-build fuzz-smoke fuzz fuzz-seeds farm-test
 
