@@ -38,6 +38,7 @@ CONFIGS = [  # (label, integrator block, spp)
     ("mfs filtered lookups", {"type": "mfs", "filtered_lookups": True}, 4),
     ("mfs path lengthening", {"type": "mfs", "path_lengthening": True}, 4),
     ("mfs source blur", {"type": "mfs", "source_blur": True}, 4),
+    ("mfs no tilt", {"type": "mfs", "camera_tilt": False}, 4),
     ("mfs beer_lambert", {"type": "mfs", "light_path": "beer_lambert"}, 4),
     ("mfs gaussian", {"type": "mfs", "propagator": "gaussian"}, 4),
     ("mfs f=0", {"type": "mfs", "peak_fraction": 0.0}, 4),
