@@ -19,18 +19,36 @@ constexpr int kAngleNodes = 512;  // theta = pi u^2, u uniform: dense near the f
 constexpr int kTauNodes = 48;     // tau = kTauMax v^2, v uniform
 constexpr int kMomentCap = 2000;
 
-// Peak mass above the level P(theta_c) inside theta < theta_c (midpoint rule in theta).
+// Panel edges for integrals over [0, theta_c]: a tabulated phase function's nodes there (its kinks;
+// a sharp table is dense near 0) and theta_c.
+std::vector<double> clip_edges(const Phase& phase, double theta_c) {
+  std::vector<double> edges{0.0};
+  if (const auto* t = std::get_if<TabulatedPhase>(&phase))
+    for (double th : t->theta)
+      if (th > 0.0 && th < theta_c) edges.push_back(th);
+  edges.push_back(theta_c);
+  return edges;
+}
+
+// Peak mass above the level P(theta_c) inside theta < theta_c: four-point Gauss-Legendre on the
+// panels of clip_edges, each cut into pieces no wider than theta_c / 500.
 double clipped_mass(const Phase& phase, double theta_c) {
   if (theta_c <= 0.0) return 0.0;
+  constexpr double x[4] = {-0.8611363115940526, -0.3399810435848563, 0.3399810435848563, 0.8611363115940526};
+  constexpr double w[4] = {0.3478548451374538, 0.6521451548625461, 0.6521451548625461, 0.3478548451374538};
   const double level = phase_eval(phase, std::cos(theta_c));
-  const int n = 4000;
-  const double h = theta_c / n;
+  const std::vector<double> edges = clip_edges(phase, theta_c);
   double m = 0.0;
-  for (int i = 0; i < n; ++i) {
-    const double th = (i + 0.5) * h;
-    m += std::max(0.0, phase_eval(phase, std::cos(th)) - level) * std::sin(th);
+  for (size_t i = 0; i + 1 < edges.size(); ++i) {
+    const int n = std::max(1, int(std::ceil((edges[i + 1] - edges[i]) * 500.0 / theta_c)));
+    const double h = (edges[i + 1] - edges[i]) / n;
+    for (int j = 0; j < n; ++j)
+      for (int q = 0; q < 4; ++q) {
+        const double th = edges[i] + h * (j + 0.5 + 0.5 * x[q]);
+        m += 0.5 * h * w[q] * std::max(0.0, phase_eval(phase, std::cos(th)) - level) * std::sin(th);
+      }
   }
-  return 2.0 * kPi * h * m;
+  return 2.0 * kPi * m;
 }
 
 // The cut angle whose clipped mass is peak_fraction (clipped mass grows with theta_c for a
@@ -46,35 +64,21 @@ double cut_angle_for(const Phase& phase, double peak_fraction) {
   return hi;
 }
 
-// Legendre moments of the wide part min(P, level) inside theta_c (tabulated finely, the cut angle a node).
-std::vector<double> wide_part_moments(const Phase& phase, double theta_c, double level) {
-  std::vector<double> theta, value;
-  const int n = 4000;
-  for (int i = 0; i < n; ++i) {
-    const double u = double(i) / (n - 1), th = kPi * u * u;
-    if (!theta.empty() && theta.back() < theta_c && th > theta_c) {
-      theta.push_back(theta_c);
-      value.push_back(level);
-    }
-    if (th == theta_c && !theta.empty() && theta.back() == th) continue;
-    theta.push_back(th);
-    value.push_back(th < theta_c ? std::min(phase_eval(phase, std::cos(th)), level)
-                                 : phase_eval(phase, std::cos(th)));
-  }
-  return phase_legendre_moments(make_tabulated_phase("mfs-wide", theta, value), 1e-8, kMomentCap);
+// The clipped-off peak max(0, P - level) inside theta < theta_c: its normalised Legendre moments by
+// quadrature over [0, theta_c] only (a tabulated phase function's nodes there and theta_c as panel
+// edges), its mass in *mass. The wide part's moments follow by difference from the whole function's.
+std::vector<double> clipped_peak_moments(const Phase& phase, double theta_c, double level, double* mass) {
+  return legendre_moments_of(
+      [&](double th) { return std::max(0.0, phase_eval(phase, std::cos(th)) - level); },
+      clip_edges(phase, theta_c), 1e-8, kMomentCap, mass);
 }
 
-// The peak's moments by difference (or its Gaussian with the same <theta^2>); a delta without a peak.
-std::vector<double> peak_part_moments(const std::vector<double>& chi_full,
-                                      const std::vector<double>& chi_wide, double f, bool gaussian) {
-  const size_t L = chi_full.size();
-  std::vector<double> chi_peak(L, 1.0);  // no peak: a delta (tau_p stays 0 anyway)
-  if (f > 0.0) {
-    for (size_t l = 0; l < L; ++l) chi_peak[l] = (chi_full[l] - (1.0 - f) * chi_wide[l]) / f;
-    if (gaussian) {
-      const double theta2 = L > 2 ? (1.0 - chi_peak[2]) / 3.0 : 0.0;
-      for (size_t l = 0; l < L; ++l) chi_peak[l] = std::exp(-0.5 * theta2 * double(l) * double(l + 1));
-    }
+// The peak's moments, or (gaussian) those of a Gaussian with the same <theta^2>.
+std::vector<double> gaussian_stand_in(std::vector<double> chi_peak, bool gaussian) {
+  if (gaussian) {
+    const size_t L = chi_peak.size();
+    const double theta2 = L > 2 ? (1.0 - chi_peak[2]) / 3.0 : 0.0;
+    for (size_t l = 0; l < L; ++l) chi_peak[l] = std::exp(-0.5 * theta2 * double(l) * double(l + 1));
   }
   return chi_peak;
 }
@@ -98,18 +102,20 @@ void legendre_terms(double mu, const std::vector<double>& chi_wide, const std::v
 }
 
 // Tables [tau node][angle node] of the wide and peak lobes after optical depth tau_p of peak
-// scattering: the unscattered term e^-tau P(mu) pointwise plus the scattered Legendre series.
+// scattering: the unscattered term e^-tau P(mu) pointwise plus the scattered Legendre series. The
+// series' sums run over l outermost, into one accumulator per tau node: each sum adds its terms in
+// the order of l, as a dot product per node would, and the loop over the nodes vectorises.
 template <typename Wide, typename Peak>
 void tabulate_lobes(const std::vector<double>& chi_wide, const std::vector<double>& chi_peak, Wide&& wide,
                     Peak&& peak, std::vector<float>& wide_table, std::vector<float>& peak_table) {
   const size_t L = chi_wide.size();
   std::vector<double> tau(kTauNodes), e_tau(kTauNodes);
-  std::vector<double> E(size_t(kTauNodes) * L);  // exp(-tau (1 - chi_peak_l)) - exp(-tau)
+  std::vector<double> E(L * kTauNodes);  // [l][tau node]: exp(-tau (1 - chi_peak_l)) - exp(-tau)
   for (int k = 0; k < kTauNodes; ++k) {
     const double v = double(k) / (kTauNodes - 1);
     tau[k] = PhaseSplit::kTauMax * v * v;
     e_tau[k] = std::exp(-tau[k]);
-    for (size_t l = 0; l < L; ++l) E[k * L + l] = std::exp(-tau[k] * (1.0 - chi_peak[l])) - e_tau[k];
+    for (size_t l = 0; l < L; ++l) E[l * kTauNodes + k] = std::exp(-tau[k] * (1.0 - chi_peak[l])) - e_tau[k];
   }
   wide_table.assign(size_t(kTauNodes) * kAngleNodes, 0.0f);
   peak_table.assign(size_t(kTauNodes) * kAngleNodes, 0.0f);
@@ -118,14 +124,18 @@ void tabulate_lobes(const std::vector<double>& chi_wide, const std::vector<doubl
     std::vector<double> cw(L), cp(L);
     legendre_terms(mu, chi_wide, chi_peak, cw, cp);
     const double w0 = wide(mu), q0 = peak(mu);
-    for (int k = 0; k < kTauNodes; ++k) {
-      double sw = 0.0, sp = 0.0;
-      for (size_t l = 0; l < L; ++l) {
-        sw += cw[l] * E[k * L + l];
-        sp += cp[l] * E[k * L + l];
+    double sw[kTauNodes] = {}, sp[kTauNodes] = {};
+    for (size_t l = 0; l < L; ++l) {
+      const double* e = &E[l * kTauNodes];
+      const double a = cw[l], b = cp[l];
+      for (int k = 0; k < kTauNodes; ++k) {
+        sw[k] += a * e[k];
+        sp[k] += b * e[k];
       }
-      wide_table[size_t(k) * kAngleNodes + j] = float(std::max(0.0, e_tau[k] * w0 + sw));
-      peak_table[size_t(k) * kAngleNodes + j] = float(std::max(0.0, e_tau[k] * q0 + sp));
+    }
+    for (int k = 0; k < kTauNodes; ++k) {
+      wide_table[size_t(k) * kAngleNodes + j] = float(std::max(0.0, e_tau[k] * w0 + sw[k]));
+      peak_table[size_t(k) * kAngleNodes + j] = float(std::max(0.0, e_tau[k] * q0 + sp[k]));
     }
   });
 }
@@ -150,13 +160,20 @@ PhaseSplit::PhaseSplit(const Phase& phase, double peak_fraction, bool gaussian) 
     level_ = phase_eval(phase, std::cos(theta_c_));
   }
 
-  // Moments of the wide part and of the peak by difference.
-  chi_wide_ = f_ > 0.0 ? wide_part_moments(phase, theta_c_, level_) : chi;
-  const size_t L = std::max(chi.size(), chi_wide_.size());
-  std::vector<double> chi_full = chi;
-  chi_full.resize(L, 0.0);
-  chi_wide_.resize(L, 0.0);
-  chi_peak_ = peak_part_moments(chi_full, chi_wide_, f_, gaussian);
+  // The peak's moments over its support, the wide part's by difference:
+  // chi_wide = (chi - f chi_peak) / (1 - f).
+  if (f_ > 0.0) {
+    std::vector<double> chi_clip = clipped_peak_moments(phase, theta_c_, level_, &f_);
+    const size_t L = std::max(chi.size(), chi_clip.size());
+    chi_clip.resize(L, 0.0);
+    chi_wide_.assign(L, 0.0);
+    for (size_t l = 0; l < L; ++l)
+      chi_wide_[l] = ((l < chi.size() ? chi[l] : 0.0) - f_ * chi_clip[l]) / (1.0 - f_);
+    chi_peak_ = gaussian_stand_in(chi_clip, gaussian);
+  } else {
+    chi_wide_ = chi;
+    chi_peak_.assign(chi.size(), 1.0);  // no peak: a delta (tau_p stays 0 anyway)
+  }
 
   tabulate_lobes(
       chi_wide_, chi_peak_, [this](double mu) { return wide(mu); }, [this](double mu) { return peak(mu); },

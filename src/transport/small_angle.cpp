@@ -21,44 +21,14 @@ constexpr double kGl4x[4] = {-0.8611363115940526, -0.3399810435848563, 0.3399810
                              0.8611363115940526};
 constexpr double kGl4w[4] = {0.3478548451374538, 0.6521451548625461, 0.6521451548625461, 0.3478548451374538};
 
-// Moments by quadrature in theta: panels no wider than 1.5 / l_cap so P_l never turns more than 1.5 rad
-// within one, nodes of a tabulated phase function kept as panel edges (its kinks).
+// Moments by quadrature in theta of the phase function (its tabulated nodes as panel edges).
 std::vector<double> quadrature_moments(const Phase& phase, double theta_max, int l_cap, double tol) {
   std::vector<double> edges;
   if (const auto* t = std::get_if<TabulatedPhase>(&phase))
     edges = t->theta;
   else
     edges = {0.0, theta_max};
-  std::vector<double> mu, wf;  // nodes cos theta, weights * phase * sin * 2 pi
-  const double hmax = 1.5 / l_cap;
-  for (size_t i = 0; i + 1 < edges.size(); ++i) {
-    const int m = std::max(1, int(std::ceil((edges[i + 1] - edges[i]) / hmax)));
-    const double h = (edges[i + 1] - edges[i]) / m;
-    for (int j = 0; j < m; ++j)
-      for (int q = 0; q < 4; ++q) {
-        const double th = edges[i] + h * (j + 0.5 + 0.5 * kGl4x[q]);
-        mu.push_back(std::cos(th));
-        wf.push_back(0.5 * h * kGl4w[q] * 2.0 * kPi * phase_eval(phase, std::cos(th)) * std::sin(th));
-      }
-  }
-  std::vector<double> p0(mu.size(), 1.0), p1(mu), chi;
-  double norm = 0.0;
-  for (double w : wf) norm += w;
-  chi.push_back(1.0);
-  int small = 0;
-  for (int l = 1; l <= l_cap; ++l) {
-    double s = 0.0;
-    for (size_t i = 0; i < mu.size(); ++i) s += wf[i] * p1[i];
-    chi.push_back(s / norm);
-    small = std::abs(chi.back()) < tol ? small + 1 : 0;
-    if (small >= 8) break;
-    for (size_t i = 0; i < mu.size(); ++i) {  // P_{l+1} = ((2l+1) mu P_l - l P_{l-1}) / (l+1)
-      const double p2 = ((2 * l + 1) * mu[i] * p1[i] - l * p0[i]) / (l + 1);
-      p0[i] = p1[i];
-      p1[i] = p2;
-    }
-  }
-  return chi;
+  return legendre_moments_of([&](double th) { return phase_eval(phase, std::cos(th)); }, edges, tol, l_cap);
 }
 
 std::vector<double> geometric_moments(double g, double w, double g2, double tol, int l_cap) {
@@ -98,6 +68,43 @@ std::vector<double> half_range_mu_moments(size_t n) {
 }
 
 }  // namespace
+
+// Panels no wider than 1.5 / l_cap so that P_l never turns more than 1.5 rad within one.
+std::vector<double> legendre_moments_of(const std::function<double(double)>& p,
+                                        const std::vector<double>& edges, double tol, int l_cap,
+                                        double* mass) {
+  std::vector<double> mu, wf;  // nodes cos theta, weights * p * sin * 2 pi
+  const double hmax = 1.5 / l_cap;
+  for (size_t i = 0; i + 1 < edges.size(); ++i) {
+    const int m = std::max(1, int(std::ceil((edges[i + 1] - edges[i]) / hmax)));
+    const double h = (edges[i + 1] - edges[i]) / m;
+    for (int j = 0; j < m; ++j)
+      for (int q = 0; q < 4; ++q) {
+        const double th = edges[i] + h * (j + 0.5 + 0.5 * kGl4x[q]);
+        mu.push_back(std::cos(th));
+        wf.push_back(0.5 * h * kGl4w[q] * 2.0 * kPi * p(th) * std::sin(th));
+      }
+  }
+  std::vector<double> p0(mu.size(), 1.0), p1(mu), chi;
+  double norm = 0.0;
+  for (double w : wf) norm += w;
+  if (mass) *mass = norm;
+  chi.push_back(1.0);
+  int small = 0;
+  for (int l = 1; l <= l_cap; ++l) {
+    double s = 0.0;
+    for (size_t i = 0; i < mu.size(); ++i) s += wf[i] * p1[i];
+    chi.push_back(s / norm);
+    small = std::abs(chi.back()) < tol ? small + 1 : 0;
+    if (small >= 8) break;
+    for (size_t i = 0; i < mu.size(); ++i) {  // P_{l+1} = ((2l+1) mu P_l - l P_{l-1}) / (l+1)
+      const double p2 = ((2 * l + 1) * mu[i] * p1[i] - l * p0[i]) / (l + 1);
+      p0[i] = p1[i];
+      p1[i] = p2;
+    }
+  }
+  return chi;
+}
 
 std::vector<double> phase_legendre_moments(const Phase& phase, double tol, int l_cap) {
   if (const auto* p = std::get_if<HgPhase>(&phase)) return geometric_moments(p->g, 1.0, 0.0, tol, l_cap);

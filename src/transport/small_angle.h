@@ -34,6 +34,7 @@
 // Integrals of the radial profile are done by numerical Hankel transforms with an analytic tail.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -44,6 +45,14 @@ namespace nimbus {
 // Legendre moments chi_l = 2 pi int P(mu) P_l(mu) dmu, l = 0..L, chi_0 = 1; closed forms for HG and
 // double HG, quadrature otherwise.  Stops once |chi_l| < tol for 8 consecutive l, or at l_cap.
 std::vector<double> phase_legendre_moments(const Phase& phase, double tol = 1e-12, int l_cap = 6000);
+
+// The normalised Legendre moments chi_l = int p P_l dOmega / int p dOmega (l = 0..L, same stopping rule)
+// of a function p(theta) >= 0 that is zero outside [edges.front(), edges.back()], by four-point
+// Gauss-Legendre panels no wider than 1.5 / l_cap between consecutive edges (p's kinks go there).
+// *mass, if given, receives int p dOmega.
+std::vector<double> legendre_moments_of(const std::function<double(double)>& p,
+                                        const std::vector<double>& edges, double tol, int l_cap,
+                                        double* mass = nullptr);
 
 // The per-component mean square deflection theta2 = <sin^2 theta> / 2 = (1 - chi_2) / 3 used to give a
 // non-Gaussian phase function a Gaussian stand-in ((1 - g^2)/3 for HG); the Gaussian peak's own theta2.
