@@ -43,7 +43,7 @@
 // | `scatter_grid_resolution` | "auto" or integer in [4, 96]  | "auto"    | scatter and beam grid nodes along the longest axis ("auto": ~1.6 optical depths per cell, 32 to 64; the header of a rendered image holds the number chosen) |
 // | `scatter_grid_bands`      | integer in [1, 3]             | 3         | spherical-harmonic bands used at lookup (l < bands) |
 // | `forward_side`            | "camera" or "light"           | "camera"  | peak scatters after the last wide scatter carried to the camera, or taken on the light's side with an exact camera leg |
-// | `beam_photons`            | integer in [0, 2^24]          | 32768     | photons per light for the peak-only beam grid (0: straight beams) |
+// | `beam_photons`            | integer in [0, 2^24]          | 32768     | photons per light for the peak-only beam grid, shared among the channels' passes in chromatic media (0: straight beams) |
 // | `photon_splat`            | "trilinear", "stochastic" or "stratified" | "trilinear" | how the scatter grid's photons deposit each track sample: over the 8 nodes around it, or whole to one of them drawn by its trilinear weight (independently, or stratified along the track); the same expected grid, more noise (the beam grid stays trilinear) |
 // | `light_blur`              | boolean                       | true      | the first wide scatter sees the beam's light-side angular spread |
 // | `path_lengthening`        | boolean                       | false     | the corrected kernel's 1 / cosh loss on paths lengthened by peak deflections |
