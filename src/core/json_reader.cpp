@@ -241,4 +241,18 @@ bool JsonObject::keyword_or_integer(const std::string& key, const std::string& k
   return true;
 }
 
+bool JsonObject::keyword_or_boolean(const std::string& key, const std::string& keyword, bool* value) {
+  if (!has(key)) {
+    used_.insert(key);
+    return false;
+  }
+  const nlohmann::json& v = field(key);
+  if (v.is_string() && v.get<std::string>() == keyword) return false;
+  if (!v.is_boolean())
+    fail(key, fmt::format("must be \"{}\", true or false, not {}", keyword,
+                          v.is_string() ? "\"" + v.get<std::string>() + "\"" : type_name(v)));
+  *value = v.get<bool>();
+  return true;
+}
+
 }  // namespace nimbus

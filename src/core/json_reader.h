@@ -51,6 +51,8 @@ class JsonObject {
                          double* value);
   bool keyword_or_integer(const std::string& key, const std::string& keyword, int64_t lo, int64_t hi,
                           int64_t* value);
+  // Either the string `keyword` (returns false) or true / false written to *value (returns true).
+  bool keyword_or_boolean(const std::string& key, const std::string& keyword, bool* value);
   Vec3 vec3(const std::string& key);
   Vec3 vec3(const std::string& key, const Vec3& fallback);
   // A number (grey) or [r, g, b], each component >= lo.

@@ -50,7 +50,8 @@ MfsSettings mfs_settings_from_json(const nlohmann::json& options, const std::str
   s.source_blur = o.boolean("source_blur", s.source_blur);
   s.camera_tilt = o.boolean("camera_tilt", s.camera_tilt);
   s.peak_toward_camera = o.boolean("peak_toward_camera", s.peak_toward_camera);
-  s.exact_light_transmittance = o.boolean("exact_light_transmittance", s.exact_light_transmittance);
+  if (bool b = false; o.keyword_or_boolean("exact_light_transmittance", "auto", &b))
+    s.exact_light_transmittance = b;
   s.shadow_map_resolution = int(o.integer("shadow_map_resolution", 8, 1024, s.shadow_map_resolution));
   o.finish();
   // The light side carries the light to every scatter through peak scatters, with photons in the true
@@ -81,12 +82,13 @@ nlohmann::json to_json(const MfsSettings& s) {
                       {"source_blur", s.source_blur},
                       {"camera_tilt", s.camera_tilt},
                       {"peak_toward_camera", s.peak_toward_camera},
-                      {"exact_light_transmittance", s.exact_light_transmittance},
                       {"shadow_map_resolution", s.shadow_map_resolution}};
   j["peak_fraction"] = s.peak_fraction ? nlohmann::json(*s.peak_fraction) : nlohmann::json("auto");
   j["large_angle_scatters"] =
       s.large_angle_scatters ? nlohmann::json(*s.large_angle_scatters) : nlohmann::json("all");
   j["photons"] = s.photons ? nlohmann::json(*s.photons) : nlohmann::json("auto");
+  j["exact_light_transmittance"] =
+      s.exact_light_transmittance ? nlohmann::json(*s.exact_light_transmittance) : nlohmann::json("auto");
   j["scatter_grid_resolution"] =
       s.scatter_grid_resolution ? nlohmann::json(*s.scatter_grid_resolution) : nlohmann::json("auto");
   return j;
@@ -161,18 +163,10 @@ MfsIntegrator::MfsIntegrator(const SceneContext& context, MfsSettings settings, 
     f_.push_back(splits_.back()->f());
     theta2_.push_back(splits_.back()->theta2());
   }
-  // Shadow-map nodes march towards the light at this optical-depth step (midpoint rule). 0.05 and 0.5
-  // give the same validation errors (the map's trilinear interpolation dominates); 0.25 halves the
-  // Disney cloud's precomputation against 0.05.
-  constexpr double map_step = 0.25;
-  for (const Light& l : ctx_.lights) {
-    const int res = is_area_light(l) ? 8 : s_.shadow_map_resolution;  // area lights: a token map (light_beam)
-    if (s_.forward_light_path())
-      TransmittanceGrid::build_pair(ctx_.media, ctx_.majorants, l, res, map_step, f_,
-                                    &full_maps_.emplace_back(), &reduced_maps_.emplace_back());
-    else
-      full_maps_.emplace_back(ctx_.media, ctx_.majorants, l, res, map_step);
-  }
+  // The light's chord in closed form where there is one (the maps' interpolation errs at sharp rims).
+  if (!s_.exact_light_transmittance)
+    s_.exact_light_transmittance = ctx_.analytic.active() && ctx_.media.count() == 1;
+  build_maps();
   if (!s_.scatter_grid_resolution) s_.scatter_grid_resolution = auto_scatter_grid_resolution(ctx_);
   if (!s_.photons) s_.photons = auto_photons(ctx_.camera);
   const std::optional<MajorantGrid> photon_majorants = photon_majorant_grid(ctx_, s_);
@@ -207,6 +201,30 @@ MfsIntegrator::MfsIntegrator(const SceneContext& context, MfsSettings settings, 
     const NodeGrid &a = grid_->node_grid(), &b = beam_->node_grid();
     shared_stencil_ = a.bounds.lo == b.bounds.lo && a.bounds.hi == b.bounds.hi && a.nodes == b.nodes &&
                       a.spacing == b.spacing;
+  }
+}
+
+void MfsIntegrator::build_maps() {
+  // Shadow-map nodes march towards the light at this optical-depth step (midpoint rule). 0.05 and 0.5
+  // give the same validation errors (the map's trilinear interpolation dominates); 0.25 halves the
+  // Disney cloud's precomputation against 0.05.
+  constexpr double map_step = 0.25;
+  const bool beam = s_.forward_light_path() && s_.beam_photons > 0;
+  for (const Light& l : ctx_.lights) {
+    const int res = is_area_light(l) ? 8 : s_.shadow_map_resolution;  // area lights: a token map (light_beam)
+    if (*s_.exact_light_transmittance) {
+      // light_beam reads the chord: only the beam grid's photons read a map (the reduced one; the
+      // same map as build_pair's).
+      full_maps_.emplace_back();
+      if (s_.forward_light_path())
+        reduced_maps_.push_back(beam ? TransmittanceGrid(ctx_.media, ctx_.majorants, l, res, map_step, f_)
+                                     : TransmittanceGrid());
+    } else if (s_.forward_light_path()) {
+      TransmittanceGrid::build_pair(ctx_.media, ctx_.majorants, l, res, map_step, f_,
+                                    &full_maps_.emplace_back(), &reduced_maps_.emplace_back());
+    } else {
+      full_maps_.emplace_back(ctx_.media, ctx_.majorants, l, res, map_step);
+    }
   }
 }
 
@@ -447,7 +465,7 @@ LightBeam MfsIntegrator::light_beam(size_t l, int i, const Vec3& p, const LightS
   if (is_area_light(ctx_.lights[l])) {  // an area light: march to its sampled point instead of a map
     marched_full_and_reduced(ctx_, p, ls.wi, ls.distance, kSurfaceShadowStep, f_, &T_light, &T_wide);
     if (!s_.forward_light_path()) T_wide = T_light;
-  } else if (s_.exact_light_transmittance) {
+  } else if (*s_.exact_light_transmittance) {
     exact_light_transmittance(p, ls, &T_light, &T_wide);
     if (!s_.forward_light_path()) T_wide = T_light;
   } else {

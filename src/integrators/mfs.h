@@ -51,7 +51,7 @@
 // | `source_blur`             | boolean                       | false     | the source (sigma_s times every scattered term) read at a point drawn from the camera-side lateral footprint (D10), so rays near a boundary gather partly outside the medium |
 // | `camera_tilt`             | boolean                       | true      | near a medium's side, the camera-bound light's direction is tilted towards the medium, as the peak-scattered paths that stayed in it are (D16; ignored with source_blur, forward_side "light" and light_path "beer_lambert") |
 // | `peak_toward_camera`      | boolean                       | false     | the forward peak alone takes its angular factor from the beam grid's photons (their P_peak towards the camera) instead of peak_eff at the beam's mean-cosine depth (one medium only) |
-// | `exact_light_transmittance` | boolean                     | false     | T_light and T_wide to directional and point lights without the shadow maps: the chord in closed form for one constant-density sphere or box, else a march |
+// | `exact_light_transmittance` | "auto" or boolean           | "auto"    | T_light and T_wide to directional and point lights without the shadow maps: the chord in closed form for one constant-density sphere or box, else a march ("auto": true for one constant-density sphere or box, else false; the header of a rendered image holds the choice) |
 // | `shadow_map_resolution`   | integer in [8, 1024]          | 64        | deep shadow map nodes along the longest axis |
 //
 // forward_side "light" needs light_path "forward" and photon_transport "exact": the other values are
@@ -103,7 +103,7 @@ struct MfsSettings {
   bool source_blur = false;
   bool camera_tilt = true;
   bool peak_toward_camera = false;
-  bool exact_light_transmittance = false;
+  std::optional<bool> exact_light_transmittance;  // nullopt: "auto" (resolved by MfsIntegrator)
   int shadow_map_resolution = 64;
 
   bool forward_light_path() const { return light_path == LightPath::forward; }
@@ -193,6 +193,9 @@ class MfsIntegrator final : public Integrator {
   // exact_light_transmittance: T_light and T_wide from p to the light sample without the shadow maps (a
   // closed-form chord for one analytic medium, else a march).
   void exact_light_transmittance(const Vec3& p, const LightSample& ls, Rgb* T_light, Rgb* T_wide) const;
+  // The shadow maps per light: the full and the reduced one (only the reduced one, for the beam grid,
+  // with exact_light_transmittance).
+  void build_maps();
   // The beam from the environment image along wi (marched: full and reduced transmittance, no beam grid).
   LightBeam environment_beam(int i, const Vec3& p, const Vec3& wi) const;
   // The scatter grid's light, taking its last wide scatter at p towards the camera (eq. D12).

@@ -241,6 +241,12 @@ TEST(Mfs, OptionsAreValidatedStrictly) {
   EXPECT_NO_THROW(parse(R"({"scatter_grid_resolution": "auto"})"));
   EXPECT_NO_THROW(parse(R"({"photons": "auto"})"));
   EXPECT_THROW(parse(R"({"photons": "many"})"), Error);
+  EXPECT_NO_THROW(parse(R"({"exact_light_transmittance": "auto"})"));
+  EXPECT_NO_THROW(parse(R"({"exact_light_transmittance": false})"));
+  EXPECT_EQ(message(R"({"exact_light_transmittance": "maybe"})"),
+            "t.json: /integrator/exact_light_transmittance: must be \"auto\", true or false, not \"maybe\"");
+  EXPECT_EQ(message(R"({"exact_light_transmittance": 1})"),
+            "t.json: /integrator/exact_light_transmittance: must be \"auto\", true or false, not a number");
   EXPECT_THROW(parse(R"({"scatter_grid_resolution": "fine"})"), Error);
   EXPECT_NO_THROW(validate_integrator_options(
       "octave", nlohmann::json::parse(R"({"octaves": 6, "a": 0.6, "b": 0.4, "c": 0.7})"), "t"));
@@ -482,6 +488,7 @@ TEST(Mfs, ExactLightTransmittanceAtABacklitRim) {
   ms.large_angle_scatters = 0;
   ms.beam_photons = 0;
   ms.tau_step = 0.02;
+  ms.exact_light_transmittance = false;  // ("auto" would take the chord for this sphere too)
   const MfsIntegrator map_mfs(ctx, ms);
   ms.exact_light_transmittance = true;
   const MfsIntegrator exact_mfs(ctx, ms);

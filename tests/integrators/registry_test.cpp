@@ -79,9 +79,10 @@ TEST(Registry, SettingsRoundTripThroughJson) {
                                               {"peak_toward_camera", true},
                                               {"exact_light_transmittance", true},
                                               {"shadow_map_resolution", 32}});
-  expect_round_trip(
-      &mfs_settings_from_json,
-      {{"peak_fraction", "auto"}, {"large_angle_scatters", "all"}, {"scatter_grid_resolution", "auto"}});
+  expect_round_trip(&mfs_settings_from_json, {{"peak_fraction", "auto"},
+                                              {"large_angle_scatters", "all"},
+                                              {"scatter_grid_resolution", "auto"},
+                                              {"exact_light_transmittance", "auto"}});
 }
 
 TEST(Registry, DefaultsAreWrittenOut) {
@@ -92,6 +93,7 @@ TEST(Registry, DefaultsAreWrittenOut) {
   EXPECT_EQ(mfs["light_path"], "forward");
   EXPECT_EQ(mfs["photon_splat"], "trilinear");
   EXPECT_EQ(mfs["camera_tilt"], true);
+  EXPECT_EQ(mfs["exact_light_transmittance"], "auto");
   EXPECT_EQ(mfs.size(), 22u);  // every option of the table in mfs.h
 }
 

@@ -61,6 +61,26 @@ TEST(RenderSettings, AutoPhotonsFollowTheWholeImagesPixels) {
             1 << 18);
 }
 
+// "auto" exact_light_transmittance: the closed-form chord for one constant-density sphere or box (the
+// same image as asking for it), the shadow maps otherwise (here: two spheres).
+TEST(RenderSettings, AutoExactLightTransmittanceIsTheChordForOneShape) {
+  const std::string mfs = R"({"type": "mfs", "spp": 1, "photons": 4096, "beam_photons": 1024)";
+  const RenderResult a = render(settings_sphere_scene(mfs + "}"));
+  EXPECT_EQ(a.settings["exact_light_transmittance"], true);
+  const RenderResult b = render(settings_sphere_scene(mfs + R"(, "exact_light_transmittance": true})"));
+  ASSERT_EQ(a.image.rgb.size(), b.image.rgb.size());
+  EXPECT_EQ(std::memcmp(a.image.rgb.data(), b.image.rgb.data(), a.image.rgb.size() * sizeof(float)), 0);
+  const RenderResult c = render(settings_sphere_scene(mfs + R"(, "exact_light_transmittance": false})"));
+  EXPECT_EQ(c.settings["exact_light_transmittance"], false);
+  EXPECT_NE(std::memcmp(a.image.rgb.data(), c.image.rgb.data(), a.image.rgb.size() * sizeof(float)), 0);
+  const Scene two = test::scene_from_json("{" + test::camera_json(8, 6) + R"(,
+    "media": [{"shape": {"type": "sphere", "center": [-0.5, 0, 0], "radius": 0.6}, "sigma_s": 3.0, "phase": {"type": "hg", "g": 0.8}},
+              {"shape": {"type": "sphere", "center": [0.5, 0, 0], "radius": 0.6}, "sigma_s": 2.0, "phase": {"type": "hg", "g": 0.8}}],
+    "lights": [{"type": "directional", "direction": [-1, 0.3, 0.2], "irradiance": 1.0}],
+    "integrator": )" + mfs + "}}");
+  EXPECT_EQ(render(two).settings["exact_light_transmittance"], false);
+}
+
 TEST(RenderSettings, OverridesAreWhatTheHeaderSays) {
   const Scene scene =
       settings_sphere_scene(R"({"type": "pathtrace", "spp": 2, "seed": 5, "max_wide_scatters": 1})");
