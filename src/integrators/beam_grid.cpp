@@ -112,8 +112,8 @@ struct BeamPhotons {
   Rgb strength;             // phi_0 = strength (/ r^2)
   Vec3 dir_w;               // a directional light's direction of travel
   bool grey;                // one pass carrying RGB (else one pass per channel)
-  size_t per_pass;           // photons per channel pass (all of the light's photons in grey media)
-  Vec3 centre;  // of the node grid's bounding sphere, which the photons are aimed at
+  size_t per_pass;          // photons per channel pass (all of the light's photons in grey media)
+  Vec3 centre;              // of the node grid's bounding sphere, which the photons are aimed at
   double radius;
   double majorant_scale;             // the share of the majorant that bounds the peak-scatter rate
   const Vec3* camera;                // tally P_peak (of medium 0) towards this point, or null
@@ -263,7 +263,6 @@ bool BeamPhotons::scatter(const Vec3& xc, Vec3* w, BeamWalk& walk, Rng& rng, Pho
   if (!(shares.sum > 0.0)) return false;
   const int m = choose_medium(shares, rng);
   const Phase& phase = ctx.media.phase(m);
-  const double f = peak_fraction[m];
   // P_peak by rejection from P: accept with f P_peak / P (expected 1 / f tries).
   const bool drawn = sample_by_rejection(
       w,
@@ -273,8 +272,8 @@ bool BeamPhotons::scatter(const Vec3& xc, Vec3* w, BeamWalk& walk, Rng& rng, Pho
         return phase_sample(phase, *w, u1, u2);
       },
       [&](const Vec3& candidate) {
-        const double mu = dot(candidate, *w), p_full = phase_eval(phase, mu);
-        return p_full > 0.0 && rng.uniform() * p_full < f * splits[m]->peak(mu);
+        // f P_peak / P = 1 - the wide share.
+        return rng.uniform() < 1.0 - splits[m]->wide_share(dot(candidate, *w));
       });
   if (!drawn) ++batch.rejection_failures;  // the photon flies on undeflected (see sample_by_rejection)
   return true;

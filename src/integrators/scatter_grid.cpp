@@ -387,14 +387,8 @@ bool ScatterPhotons::scatter(const Vec3& xc, Vec3* w, int c, double* weight, int
 // class; similarity: a wide scatter). False ends the photon (its K-th wide scatter).
 bool ScatterPhotons::turn(int m, Vec3* w, int* order, Rng& rng, PhotonBatch& batch) const {
   const Phase& phase = ctx.media.phase(m);
-  const double f = peak_fraction[m];
   // The probability that a scatter into direction cosine mu is a wide one: (1 - f) P_wide / P.
-  auto wide_share = [&](double mu) {
-    const double p_full = phase_eval(phase, mu);
-    const double share = p_full > 0.0 ? (1.0 - f) * splits[m]->wide(mu) / p_full : 1.0;
-    NIMBUS_DCHECK(share >= 0.0 && share <= 1.0 + 1e-9);
-    return share;
-  };
+  auto wide_share = [&](double mu) { return splits[m]->wide_share(mu); };
   if (s.exact_transport) {
     // The full phase function; the scatter counts as wide with its share.
     const double v1 = rng.uniform(), v2 = rng.uniform();

@@ -158,6 +158,7 @@ PhaseSplit::PhaseSplit(const Phase& phase, double peak_fraction, bool gaussian) 
     theta_c_ = cut_angle_for(phase, peak_fraction);
     f_ = clipped_mass(phase, theta_c_);
     level_ = phase_eval(phase, std::cos(theta_c_));
+    cos_c_ = std::cos(theta_c_);
   }
 
   // The peak's moments over its support, the wide part's by difference:

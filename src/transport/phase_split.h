@@ -38,6 +38,13 @@ class PhaseSplit {
   // Normalised parts, per sr, at cos_theta between propagation directions.
   double wide(double cos_theta) const;
   double peak(double cos_theta) const;
+  // The probability that a scatter into cos_theta is a wide one, (1 - f) P_wide / P: 1 outside the cut
+  // angle, min(1, P(theta_c) / P) inside (no acos, one phase evaluation inside only).
+  double wide_share(double cos_theta) const {
+    if (!(f_ > 0.0) || cos_theta <= cos_c_) return 1.0;
+    const double p = phase_eval(phase_, cos_theta);
+    return p > level_ ? level_ / p : 1.0;
+  }
   // Propagated parts (see above), per sr; tau_p >= 0 (clamped to the table's range).
   double wide_eff(double tau_p, double cos_theta) const {
     return lookup(wide_table_, tau_p, angle(cos_theta));
@@ -69,6 +76,7 @@ class PhaseSplit {
 
   Phase phase_;
   double f_ = 0.0, theta_c_ = 0.0, level_ = 0.0;  // level_ = P(theta_c)
+  double cos_c_ = 1.0;                            // cos theta_c
   std::vector<double> chi_peak_, chi_wide_;
   std::vector<float> wide_table_, peak_table_;  // [tau node][angle node]
 };

@@ -48,6 +48,12 @@ TEST(PhaseSplit, PartsAreNormalisedAndRecombine) {
       EXPECT_GE(split.peak(mu), 0.0);
       EXPECT_GE(split.wide(mu), 0.0);
     }
+    // The wide share of a scatter into mu (no acos) is (1 - f) P_wide / P, and 1 - it is f P_peak / P.
+    for (double mu : {-1.0, -0.3, 0.0, 0.6, std::cos(split.cut_angle()) + 1e-9, 0.95, 0.999, 1.0}) {
+      const double p = phase_eval(phase, mu);
+      EXPECT_NEAR(split.wide_share(mu), (1 - f) * split.wide(mu) / p, 1e-12) << mu;
+      EXPECT_NEAR(1.0 - split.wide_share(mu), f * split.peak(mu) / p, 1e-12) << mu;
+    }
     // tau_p -> 0: the table reproduces the parts (no propagation yet).
     for (double mu : {-0.9, 0.0, 0.5, 0.9}) {
       EXPECT_NEAR(split.wide_eff(0.0, mu), split.wide(mu), 0.02 * split.wide(mu) + 1e-4) << mu;
