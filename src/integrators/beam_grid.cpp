@@ -344,7 +344,7 @@ bool BeamGrid::lookup(size_t light, const Vec3& p, Rgb* factor, Rgb* mean_cosine
 bool BeamGrid::lookup(size_t light, const Vec3& p, const TrilinearStencil& st, Rgb* factor, Rgb* mean_cosine,
                       Rgb* peak_toward) const {
   if (light >= values_.size() || values_[light].empty() || !grid_.bounds.contains(p)) return false;
-  const std::vector<float>& v = values_[light];
+  const FloatArray& v = values_[light];
   Rgb r(0.0), m(0.0), straight(0.0), pk(0.0);
   for (int k = 0; k < 8; ++k)
     for (int c = 0; c < 3; ++c) {

@@ -58,8 +58,8 @@ class BeamGrid {
   double idle_share() const { return idle_share_; }
 
  private:
-  NodeGrid grid_;                           // the media's bounds padded by one spacing (node_grid_padded)
-  std::vector<std::vector<float>> values_;  // per light and node: traced, traced x cosine, straight (rgb)
+  NodeGrid grid_;                   // the media's bounds padded by one spacing (node_grid_padded)
+  std::vector<FloatArray> values_;  // per light and node: traced, traced x cosine, straight (rgb)
   uint64_t rejection_failures_ = 0;
   double idle_share_ = 0.0;
   int stride_;        // floats per node

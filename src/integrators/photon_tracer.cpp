@@ -115,14 +115,14 @@ TracedBatches run_batches(size_t total, uint64_t stream_seed, size_t tally_size,
 
 }  // namespace
 
-std::vector<float> trace_photons(size_t total, uint64_t stream_seed, size_t tally_size, double scale,
-                                 const TracePhoton& trace_photon, uint64_t* rejection_failures) {
+FloatArray trace_photons(size_t total, uint64_t stream_seed, size_t tally_size, double scale,
+                         const TracePhoton& trace_photon, uint64_t* rejection_failures) {
   // (Named, not a structured binding: clang 14 cannot capture one in the lambdas below.)
   const TracedBatches traced = run_batches(total, stream_seed, tally_size, trace_photon, rejection_failures);
   const std::vector<PhotonBatch>& batch = traced.batch;
   const std::vector<double>& batch_scale = traced.scale;
   // Sum the batches in order (the same sum for every thread count).
-  std::vector<float> sum(tally_size);
+  FloatArray sum(tally_size);
   tbb::parallel_for(size_t(0), tally_size, [&](size_t n) {
     double s = 0.0;
     for (int b = 0; b < kPhotonBatches; ++b) s += batch_scale[b] * batch[b].tally[n];
@@ -131,16 +131,16 @@ std::vector<float> trace_photons(size_t total, uint64_t stream_seed, size_t tall
   return sum;
 }
 
-std::vector<float> trace_photons_folded(size_t total, uint64_t stream_seed, size_t tally_size, double scale,
-                                        const TallyFold& fold, const TracePhoton& trace_photon,
-                                        uint64_t* rejection_failures) {
+FloatArray trace_photons_folded(size_t total, uint64_t stream_seed, size_t tally_size, double scale,
+                                const TallyFold& fold, const TracePhoton& trace_photon,
+                                uint64_t* rejection_failures) {
   // (Named, not a structured binding: clang 14 cannot capture one in the lambdas below.)
   const TracedBatches traced = run_batches(total, stream_seed, tally_size, trace_photon, rejection_failures);
   const std::vector<PhotonBatch>& batch = traced.batch;
   const std::vector<double>& batch_scale = traced.scale;
   // Fold the batches node by node, in order (the same sum for every thread count).
   const int k = fold.out_floats;
-  std::vector<float> sum(fold.nodes * size_t(k));
+  FloatArray sum(fold.nodes * size_t(k));
   tbb::parallel_for(tbb::blocked_range<size_t>(0, fold.nodes), [&](const tbb::blocked_range<size_t>& r) {
     std::vector<double> acc(static_cast<size_t>(k));
     for (size_t n = r.begin(); n != r.end(); ++n) {

@@ -61,8 +61,8 @@ struct PhotonBatch {
 // planned / traced photons. Returns the batches' tallies summed in order, times `scale`, and adds
 // their rejection failures to *rejection_failures.
 using TracePhoton = std::function<void(size_t j, Rng& rng, PhotonBatch& batch)>;
-std::vector<float> trace_photons(size_t total, uint64_t stream_seed, size_t tally_size, double scale,
-                                 const TracePhoton& trace_photon, uint64_t* rejection_failures);
+FloatArray trace_photons(size_t total, uint64_t stream_seed, size_t tally_size, double scale,
+                         const TracePhoton& trace_photon, uint64_t* rejection_failures);
 
 // A batch tally laid out otherwise than the result: trace_photons_folded's tally has tally_size floats
 // per batch, and fold(tally, node, weight, acc) adds weight times node `node`'s result (out_floats
@@ -74,9 +74,9 @@ struct TallyFold {
   std::function<void(const float* tally, size_t node, double weight, double* acc)> fold;
 };
 // trace_photons with the batches' tallies folded (in order, in double) into nodes x out_floats values.
-std::vector<float> trace_photons_folded(size_t total, uint64_t stream_seed, size_t tally_size, double scale,
-                                        const TallyFold& fold, const TracePhoton& trace_photon,
-                                        uint64_t* rejection_failures);
+FloatArray trace_photons_folded(size_t total, uint64_t stream_seed, size_t tally_size, double scale,
+                                const TallyFold& fold, const TracePhoton& trace_photon,
+                                uint64_t* rejection_failures);
 
 // The share of the majorant that bounds an extinction which keeps, of each medium i, its absorption
 // and kept(i) (in [0, 1]) of its scattering (the colour grid's tint, at most 1, only lowers it):

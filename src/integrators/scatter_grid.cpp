@@ -124,9 +124,8 @@ void deposit_flight(float* tally, const TallyBlock& block, const NodeGrid& grid,
 
 // The next pre-filtered level: the values (`floats` per node) of `fine` at its nodes 2j, filtered with
 // the tent (1/4, 1/2, 1/4) per axis, on `coarse` (nodes beyond fine's last are clamped to it).
-std::vector<float> tent_downsample(const NodeGrid& fine, const float* src, const NodeGrid& coarse,
-                                   int floats) {
-  std::vector<float> values(coarse.size() * floats, 0.0f);
+FloatArray tent_downsample(const NodeGrid& fine, const float* src, const NodeGrid& coarse, int floats) {
+  FloatArray values(coarse.size() * floats, 0.0f);
   const std::array<int, 3> nb = fine.nodes;
   auto at = [&](int x, int y, int z) {
     x = std::clamp(x, 0, nb[0] - 1), y = std::clamp(y, 0, nb[1] - 1), z = std::clamp(z, 0, nb[2] - 1);

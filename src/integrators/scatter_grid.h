@@ -42,6 +42,7 @@
 
 #include "core/node_grid.h"
 #include "core/sh.h"
+#include "core/zeroed_floats.h"
 #include "integrators/integrator.h"
 #include "media/majorant.h"
 #include "transport/phase_split.h"
@@ -116,10 +117,10 @@ class ScatterGrid {
   NodeGrid grid_;  // the media's bounds padded by one spacing (node_grid_padded)
   int bands_ = 3, coeffs_ = 9;
   uint64_t rejection_failures_ = 0;
-  std::vector<float> values_;  // per node: channel c at [coeffs c + h]: L_lm, h = l^2 + l + m
+  FloatArray values_;  // per node: channel c at [coeffs c + h]: L_lm, h = l^2 + l + m
   struct Level {
     NodeGrid grid;  // nodes at grid_.bounds.lo + j spacing (may overhang grid_.bounds)
-    std::vector<float> values;
+    FloatArray values;
   };
   std::vector<Level> mips_;  // levels 1, 2, ...
   // The moments at p of level k (0: values_), summed into L with weight wt.

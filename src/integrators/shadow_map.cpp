@@ -111,8 +111,8 @@ struct AxisOffset {
 // depth to the light per node, rgb (lookups interpolate it and exponentiate; see lookup).
 struct MapValues {
   NodeGrid g;
-  std::vector<float>* full;
-  std::vector<float>* reduced;
+  FloatArray* full;
+  FloatArray* reduced;
   void store(size_t node, const Rgb& tau_full, const Rgb& tau_reduced) const {
     for (int c = 0; c < 3; ++c) {
       if (full) (*full)[node * 3 + c] = float(tau_full[c]);
@@ -167,7 +167,7 @@ void sweep_towards(const SceneMedia& media, const MajorantGrid& grid, const Vec3
         off_c(w[c] * t_seg / g.spacing[c], how.cubic);
     // The optical depth in slice j where a node's segment of t_seg towards the light meets it (depth,
     // not transmittance: it is the smoother of the two, and a lerp of T errs by the convexity of exp).
-    const auto in_slice = [&](const std::vector<float>& v, int kb, int kc) {
+    const auto in_slice = [&](const FloatArray& v, int kb, int kc) {
       Rgb column[4];
       for (int qc = 0; qc < 4; ++qc) {
         Rgb row[4];

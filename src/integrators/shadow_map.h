@@ -11,6 +11,7 @@
 
 #include "core/math.h"
 #include "core/node_grid.h"
+#include "core/zeroed_floats.h"
 #include "media/majorant.h"
 #include "media/media.h"
 #include "nimbus/scene.h"
@@ -68,8 +69,8 @@ class TransmittanceGrid {
                     double tau_step, const std::vector<double>& peak_fraction, TransmittanceGrid* full,
                     TransmittanceGrid* reduced, MapBuild how);
 
-  NodeGrid grid_;              // nodes on the media's bounds (node_grid_spanning)
-  std::vector<float> values_;  // optical depth -log T per node, rgb
+  NodeGrid grid_;      // nodes on the media's bounds (node_grid_spanning)
+  FloatArray values_;  // optical depth -log T per node, rgb
 };
 
 }  // namespace nimbus

@@ -34,5 +34,31 @@ TEST(ZeroedFloats, MoveHandsOverTheArray) {
   EXPECT_EQ(c.size(), size_t(1) << 20);
 }
 
+// FloatArray: a std::vector whose large blocks are huge-page mappings (2 MiB-aligned on Linux); filled,
+// grown past the mapping threshold (a copy into a new block), copied and freed like any vector (ASan
+// checks the frees).
+TEST(FloatArray, BehavesAsAVector) {
+  FloatArray a(1000, 2.0f);  // the heap
+  EXPECT_EQ(a[999], 2.0f);
+  a.resize(size_t(1) << 20, 1.0f);  // 4 MiB: mapped
+#if defined(__linux__)
+  EXPECT_EQ(reinterpret_cast<size_t>(a.data()) % (size_t(2) << 20), 0u);
+#endif
+  EXPECT_EQ(a[999], 2.0f);
+  EXPECT_EQ(a[1000], 1.0f);
+  EXPECT_EQ(a.back(), 1.0f);
+  FloatArray b = a;
+  b[7] = 5.0f;
+  EXPECT_EQ(a[7], 2.0f);
+  EXPECT_EQ(b[7], 5.0f);
+  const FloatArray zero(size_t(3) << 20);  // value-initialised: zero
+  size_t nonzero = 0;
+  for (float v : zero) nonzero += v != 0.0f;
+  EXPECT_EQ(nonzero, 0u);
+  a.clear();
+  a.shrink_to_fit();
+  EXPECT_TRUE(a.empty());
+}
+
 }  // namespace
 }  // namespace nimbus

@@ -15,7 +15,7 @@ namespace {
 TEST(PhotonTracer, BatchesSumEveryPhotonOnce) {
   const size_t total = 1003;  // not a multiple of the batch count
   uint64_t failures = 0;
-  const std::vector<float> sum = trace_photons(
+  const FloatArray sum = trace_photons(
       total, 42, 2, 0.5,
       [](size_t j, Rng& rng, PhotonBatch& batch) {
         batch.tally[0] += 1.0f;
@@ -34,7 +34,7 @@ TEST(PhotonTracer, WorkBudgetScalesTheTracedPhotonsToThePlannedOnes) {
   uint64_t failures = 0;
   // Each photon costs 4 times the budget's share: a batch of 10 stops after 3 photons (4 x 512 x 3 >
   // 512 x 10) and scales its tally by 10 / 3.
-  const std::vector<float> sum = trace_photons(
+  const FloatArray sum = trace_photons(
       total, 1, 1, 1.0,
       [&](size_t, Rng&, PhotonBatch& batch) {
         batch.tally[0] += 1.0f;
