@@ -27,8 +27,8 @@ inline constexpr size_t kMapBytes = size_t(1) << 20;  // smaller blocks: the C h
 // or a 1.4 MB array whole, would fault 4 KiB at a time): `bytes` rounded up to whole huge pages.
 inline size_t whole(size_t bytes) { return (bytes + kHugePage - 1) & ~(kHugePage - 1); }
 
-// Fresh zero pages for `bytes` (>= kMapBytes), asked for as transparent huge pages; null where there is no
-// mmap (the caller falls back to the heap). Pages never touched cost nothing.
+// Fresh zero pages for `bytes`, asked for as transparent huge pages; only where mapped(bytes) (Linux, and
+// at least kMapBytes: the callers take smaller blocks from the heap). Pages never touched cost nothing.
 inline void* map(size_t bytes) {
 #if defined(__linux__)
   const size_t w = whole(bytes);
