@@ -192,6 +192,7 @@ MfsIntegrator::MfsIntegrator(const SceneContext& context, MfsSettings settings, 
     grid.channel_passes = s_.channel_passes;
     grid.bands = s_.scatter_grid_bands;
     grid.live_nodes_only = !s_.filtered_lookups;  // the pre-filtered levels read every node
+    grid.prefiltered = s_.filtered_lookups;       // only filtered lookups read them
     grid.splat = s_.photon_splat;
     grid.seed = seed;
     grid.majorants = tracking;

@@ -632,7 +632,7 @@ void ScatterGrid::trace(const SceneContext& ctx, const std::vector<const PhaseSp
   values_ = trace_photons_folded(
       total, s.seed ^ 0x6d756c7469706c65ull, tally_size, 1.0 / grid_.cell_volume(), fold,
       [&](size_t j, Rng& rng, PhotonBatch& batch) { photons.trace(j, rng, batch); }, &rejection_failures_);
-  build_mips();
+  if (s.prefiltered) build_mips();
 }
 
 void ScatterGrid::build_mips() {

@@ -69,6 +69,9 @@ struct ScatterGridSettings {
   // filtered_lookups (which reads the pre-filtered levels, built from every node): the image is
   // bit-identical and the set-up ~5 % cheaper on the Disney cloud (docs/benchmarks.md, issue 12).
   bool live_nodes_only = false;
+  // Build the pre-filtered levels (scattered_filtered reads them; without them it reads the grid itself).
+  // `mfs` builds them only for filtered_lookups: the same images, less set-up.
+  bool prefiltered = true;
   // How each deposit sample spreads over the 8 nodes around it (core/node_grid.h): trilinearly, or
   // whole to one of them drawn by its trilinear weight (the same expected grid, one write instead of 8).
   // Trilinear by default: on the Disney cloud the stochastic splat saves ~4 % of the set-up and adds
