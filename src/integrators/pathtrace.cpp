@@ -109,9 +109,7 @@ PathTracer::PathTracer(const SceneContext& context, int max_events, PathTraceSet
 
 double PathTracer::split_weight(int medium, double mu, int wide) const {
   if (splits_.empty()) return 1.0;
-  const PhaseSplit& split = *splits_[medium];
-  const double p = phase_eval(ctx_.media.phase(medium), mu);
-  const double share = p > 0.0 ? std::clamp((1.0 - split.f()) * split.wide(mu) / p, 0.0, 1.0) : 1.0;
+  const double share = splits_[medium]->wide_share(mu);
   const int K = *s_.max_wide_scatters;
   return (wide + 1 <= K ? share : 0.0) + (wide <= K ? 1.0 - share : 0.0);
 }
@@ -269,9 +267,7 @@ bool PathTracer::scatter(int medium, Vec3& d, int& wide, Rng& rng) const {
   const Vec3 d_new = phase_sample(ctx_.media.phase(medium), d, u1, u2);
   if (!splits_.empty()) {
     // Classify the scatter (probability = its wide share); paths over the limit end here.
-    const PhaseSplit& split = *splits_[medium];
-    const double mu = dot(d, d_new), p = phase_eval(ctx_.media.phase(medium), mu);
-    const double share = p > 0.0 ? (1.0 - split.f()) * split.wide(mu) / p : 1.0;
+    const double share = splits_[medium]->wide_share(dot(d, d_new));
     if (rng.uniform() < share && ++wide > *s_.max_wide_scatters) return false;
   }
   d = d_new;
