@@ -34,21 +34,13 @@ std::vector<double> clip_edges(const Phase& phase, double theta_c) {
 // panels of clip_edges, each cut into pieces no wider than theta_c / 500.
 double clipped_mass(const Phase& phase, double theta_c) {
   if (theta_c <= 0.0) return 0.0;
-  constexpr double x[4] = {-0.8611363115940526, -0.3399810435848563, 0.3399810435848563, 0.8611363115940526};
-  constexpr double w[4] = {0.3478548451374538, 0.6521451548625461, 0.6521451548625461, 0.3478548451374538};
   const double level = phase_eval(phase, std::cos(theta_c));
-  const std::vector<double> edges = clip_edges(phase, theta_c);
+  std::vector<double> wf;
+  sphere_quadrature([&](double th) { return std::max(0.0, phase_eval(phase, std::cos(th)) - level); },
+                    clip_edges(phase, theta_c), theta_c / 500.0, nullptr, &wf);
   double m = 0.0;
-  for (size_t i = 0; i + 1 < edges.size(); ++i) {
-    const int n = std::max(1, int(std::ceil((edges[i + 1] - edges[i]) * 500.0 / theta_c)));
-    const double h = (edges[i + 1] - edges[i]) / n;
-    for (int j = 0; j < n; ++j)
-      for (int q = 0; q < 4; ++q) {
-        const double th = edges[i] + h * (j + 0.5 + 0.5 * x[q]);
-        m += 0.5 * h * w[q] * std::max(0.0, phase_eval(phase, std::cos(th)) - level) * std::sin(th);
-      }
-  }
-  return 2.0 * kPi * m;
+  for (double w : wf) m += w;
+  return m;
 }
 
 // The cut angle whose clipped mass is peak_fraction (clipped mass grows with theta_c for a

@@ -69,22 +69,28 @@ std::vector<double> half_range_mu_moments(size_t n) {
 
 }  // namespace
 
-// Panels no wider than 1.5 / l_cap so that P_l never turns more than 1.5 rad within one.
-std::vector<double> legendre_moments_of(const std::function<double(double)>& p,
-                                        const std::vector<double>& edges, double tol, int l_cap,
-                                        double* mass) {
-  std::vector<double> mu, wf;  // nodes cos theta, weights * p * sin * 2 pi
-  const double hmax = 1.5 / l_cap;
+void sphere_quadrature(const std::function<double(double)>& p, const std::vector<double>& edges, double hmax,
+                       std::vector<double>* mu, std::vector<double>* wf) {
+  if (mu) mu->clear();
+  wf->clear();
   for (size_t i = 0; i + 1 < edges.size(); ++i) {
     const int m = std::max(1, int(std::ceil((edges[i + 1] - edges[i]) / hmax)));
     const double h = (edges[i + 1] - edges[i]) / m;
     for (int j = 0; j < m; ++j)
       for (int q = 0; q < 4; ++q) {
         const double th = edges[i] + h * (j + 0.5 + 0.5 * kGl4x[q]);
-        mu.push_back(std::cos(th));
-        wf.push_back(0.5 * h * kGl4w[q] * 2.0 * kPi * p(th) * std::sin(th));
+        if (mu) mu->push_back(std::cos(th));
+        wf->push_back(0.5 * h * kGl4w[q] * 2.0 * kPi * p(th) * std::sin(th));
       }
   }
+}
+
+// Panels no wider than 1.5 / l_cap so that P_l never turns more than 1.5 rad within one.
+std::vector<double> legendre_moments_of(const std::function<double(double)>& p,
+                                        const std::vector<double>& edges, double tol, int l_cap,
+                                        double* mass) {
+  std::vector<double> mu, wf;  // nodes cos theta, weights * p * sin * 2 pi
+  sphere_quadrature(p, edges, 1.5 / l_cap, &mu, &wf);
   std::vector<double> p0(mu.size(), 1.0), p1(mu), chi;
   double norm = 0.0;
   for (double w : wf) norm += w;

@@ -46,6 +46,12 @@ namespace nimbus {
 // double HG, quadrature otherwise.  Stops once |chi_l| < tol for 8 consecutive l, or at l_cap.
 std::vector<double> phase_legendre_moments(const Phase& phase, double tol = 1e-12, int l_cap = 6000);
 
+// Four-point Gauss-Legendre nodes for integrals over the sphere of a function p(theta) that is zero outside
+// [edges.front(), edges.back()]: panels no wider than hmax between consecutive edges (p's kinks go there);
+// *mu (unless null) gets each node's cos theta, *wf its weight times p(theta) sin theta 2 pi (their sum: int p dOmega).
+void sphere_quadrature(const std::function<double(double)>& p, const std::vector<double>& edges, double hmax,
+                       std::vector<double>* mu, std::vector<double>* wf);
+
 // The normalised Legendre moments chi_l = int p P_l dOmega / int p dOmega (l = 0..L, same stopping rule)
 // of a function p(theta) >= 0 that is zero outside [edges.front(), edges.back()], by four-point
 // Gauss-Legendre panels no wider than 1.5 / l_cap between consecutive edges (p's kinks go there).
