@@ -453,15 +453,21 @@ TEST(Mfs, ThickPeakOnlyPathsMatchThePathTracerWithTheTracedBeam) {
   EXPECT_NEAR(straight[0], ref[0], 0.08 * ref[0]);
 }
 
+// A unit sphere (HG 0.85) lit from the side, seen by a pixels x pixels camera with a 40 degree field.
+Scene side_lit_sphere(int pixels, double sigma_s, double sigma_a) {
+  return test::scene_from_json("{" + test::camera_json(pixels, pixels, 40.0) + R"(,
+    "media": [{"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1}, "sigma_s": )" +
+                               std::to_string(sigma_s) + R"(, "sigma_a": )" + std::to_string(sigma_a) + R"(,
+               "phase": {"type": "hg", "g": 0.85}}],
+    "lights": [{"type": "directional", "direction": [-1, 0.1, 0.05], "irradiance": 1.0}]})");
+}
+
 // Paths with at most one wide scatter in a side-lit sphere of optical radius 5 against the path
 // tracer's tally of the same paths: the beam reaching the wide scatter has crossed several peak optical
 // depths and is spread in angle; treating it as collimated (the seed's picture) is 15 % dark here, the
 // spread beam 7 % (measured; the rest is the straight-line picture of the camera side).
 TEST(Mfs, FirstWideScatterSeesTheBeamsSpread) {
-  Scene scene = test::scene_from_json("{" + test::camera_json(24, 24, 40.0) + R"(,
-    "media": [{"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1}, "sigma_s": 5.0, "sigma_a": 0.05,
-               "phase": {"type": "hg", "g": 0.85}}],
-    "lights": [{"type": "directional", "direction": [-1, 0.1, 0.05], "irradiance": 1.0}]})");
+  Scene scene = side_lit_sphere(24, 5.0, 0.05);
   scene.integrator.type = "pathtrace";
   scene.integrator.spp = 256;
   scene.integrator.options = {{"max_wide_scatters", 1}};
@@ -802,10 +808,7 @@ TEST(Mfs, CameraTiltBalancesTheLitAndFarHalves) {
 // sharp lobe that the tilt's Gaussian picture misplaces), forward_side "light" (no camera-side spread) and
 // source_blur: the images are those without it, bit for bit; with the defaults it changes them.
 TEST(Mfs, CameraTiltIsOffWhereItDoesNotApply) {
-  Scene scene = test::scene_from_json("{" + test::camera_json(12, 12, 40.0) + R"(,
-    "media": [{"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1}, "sigma_s": 3.0, "sigma_a": 0.03,
-               "phase": {"type": "hg", "g": 0.85}}],
-    "lights": [{"type": "directional", "direction": [-1, 0.1, 0.05], "irradiance": 1.0}]})");
+  Scene scene = side_lit_sphere(12, 3.0, 0.03);
   scene.integrator.type = "mfs";
   scene.integrator.spp = 2;
   const nlohmann::json small = {{"photons", 1 << 12}, {"beam_photons", 1 << 12}};  // the grids' cost
