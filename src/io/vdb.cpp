@@ -20,12 +20,6 @@
 
 namespace nimbus {
 
-namespace detail {
-void fail(const std::filesystem::path& file, const std::string& what) {
-  throw Error(fmt::format("{}: {}", file.string(), what));
-}
-}  // namespace detail
-
 namespace {
 
 namespace fs = std::filesystem;

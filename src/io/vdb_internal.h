@@ -2,6 +2,7 @@
 // reader. Not a public header.
 #pragma once
 
+#include <fmt/format.h>
 #include <nanovdb/util/GridHandle.h>
 #include <nanovdb/util/HostBuffer.h>
 
@@ -11,14 +12,23 @@
 #include <vector>
 
 #include "io/vdb.h"
+#include "nimbus/error.h"
 
 namespace nimbus::detail {
 
 using NanoHandle = nanovdb::GridHandle<nanovdb::HostBuffer>;
 
-// "<file>: <what>" as a nimbus::Error.
-[[noreturn]] void fail(const std::filesystem::path& file, const std::string& what);
+// "<file>: <what>" as a nimbus::Error. Inline: the OpenVDB module (below) holds its own copy.
+[[noreturn]] inline void fail(const std::filesystem::path& file, const std::string& what) {
+  throw Error(fmt::format("{}: {}", file.string(), what));
+}
 
+// The OpenVDB side. libopenvdb costs every process that links it about 0.05 CPU s at start (the dynamic
+// linker resolves its 69 000 symbol relocations), so by default it lives in a module of its own,
+// libnimbus_openvdb.so, loaded with dlopen when the first .vdb file is read (io/vdb_openvdb_loader.cpp);
+// .nvdb files and scenes without volume files never load it. Programs that use OpenVDB themselves (the
+// tests, the Python module) and the sanitizer builds link it in (CMakeLists.txt, NIMBUS_LAZY_OPENVDB).
+//
 // Reads the float grid `grid_name` ("" = the first float grid) of an OpenVDB file and converts it to
 // NanoVDB; `upsample` > 1 first refines it by that factor per axis (io/vdb_upsample.h: the same density
 // field on a finer lattice). Errors name the file; OpenVDB exceptions are rethrown as nimbus::Error.
@@ -31,6 +41,16 @@ std::array<NanoHandle, 3> load_openvdb_vec3_grid(const std::filesystem::path& fi
 
 // Every grid of an OpenVDB file, for `nimbus info`.
 std::vector<GridInfo> inspect_openvdb_file(const std::filesystem::path& file);
+
+// The module's functions, as one table (the module exports nothing else: nimbus_openvdb_module()).
+struct OpenVdbModule {
+  int abi;  // kOpenVdbModuleAbi of the build that made it
+  NanoHandle (*load_float_grid)(const std::filesystem::path&, const std::string&, int);
+  std::array<NanoHandle, 3> (*load_vec3_grid)(const std::filesystem::path&, const std::string&);
+  std::vector<GridInfo> (*inspect_file)(const std::filesystem::path&);
+};
+// Raised whenever OpenVdbModule or the types it passes change shape.
+inline constexpr int kOpenVdbModuleAbi = 1;
 
 // Voxel index coordinates must lie in [-2^30, 2^30): far inside int32, so node and bbox arithmetic
 // (origin + node size, max + 1) cannot overflow.

@@ -184,8 +184,7 @@ static void check_upsample(const std::filesystem::path& path, const openvdb::Flo
                      name, factor, double(voxels)));
 }
 
-NanoHandle load_openvdb_float_grid(const std::filesystem::path& path, const std::string& grid_name,
-                                   int upsample) {
+static NanoHandle float_grid(const std::filesystem::path& path, const std::string& grid_name, int upsample) {
   return with_grids(path, [&](const openvdb::GridPtrVec& grids) {
     openvdb::GridBase::ConstPtr chosen;
     for (const auto& g : grids) {
@@ -219,8 +218,7 @@ NanoHandle load_openvdb_float_grid(const std::filesystem::path& path, const std:
   });
 }
 
-std::array<NanoHandle, 3> load_openvdb_vec3_grid(const std::filesystem::path& path,
-                                                 const std::string& grid_name) {
+static std::array<NanoHandle, 3> vec3_grid(const std::filesystem::path& path, const std::string& grid_name) {
   return with_grids(path, [&](const openvdb::GridPtrVec& grids) {
     openvdb::Vec3SGrid::ConstPtr grid;
     for (const auto& g : grids)
@@ -258,7 +256,7 @@ std::array<NanoHandle, 3> load_openvdb_vec3_grid(const std::filesystem::path& pa
   });
 }
 
-std::vector<GridInfo> inspect_openvdb_file(const std::filesystem::path& path) {
+static std::vector<GridInfo> file_grids(const std::filesystem::path& path) {
   return with_grids(path, [&](const openvdb::GridPtrVec& grids) {
     std::vector<GridInfo> out;
     for (const auto& g : grids) {
@@ -308,3 +306,12 @@ std::vector<GridInfo> inspect_openvdb_file(const std::filesystem::path& path) {
 }
 
 }  // namespace nimbus::detail
+
+// The module's one export (io/vdb_internal.h): the table of the three functions above.
+extern "C" __attribute__((visibility("default"))) const nimbus::detail::OpenVdbModule*
+nimbus_openvdb_module() {
+  static constexpr nimbus::detail::OpenVdbModule table{
+      nimbus::detail::kOpenVdbModuleAbi, &nimbus::detail::float_grid, &nimbus::detail::vec3_grid,
+      &nimbus::detail::file_grids};
+  return &table;
+}

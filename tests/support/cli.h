@@ -21,10 +21,10 @@ struct CliRun {
   std::string out;  // stdout and stderr together
 };
 
-// `nimbus ARGS` with its output captured.
-inline CliRun run_cli(const std::string& args) {
+// `ENV nimbus ARGS` with its output captured; ENV: shell variable assignments, each followed by a space.
+inline CliRun run_cli_env(const std::string& env, const std::string& args) {
   CliRun r;
-  const std::string cmd = std::string(NIMBUS_CLI) + " " + args + " 2>&1";
+  const std::string cmd = env + std::string(NIMBUS_CLI) + " " + args + " 2>&1";
   FILE* p = ::popen(cmd.c_str(), "r");
   if (!p) return r;
   char buf[4096];
@@ -34,6 +34,9 @@ inline CliRun run_cli(const std::string& args) {
   r.rc = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return r;
 }
+
+// `nimbus ARGS` with its output captured.
+inline CliRun run_cli(const std::string& args) { return run_cli_env("", args); }
 
 // `nimbus ARGS` with its output left in the test log; the exit code.
 inline int run_cli_status(const std::string& args) {
