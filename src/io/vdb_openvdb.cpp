@@ -1,4 +1,5 @@
-// Volume files, OpenVDB side: the only translation unit that includes OpenVDB (it compiles slowly).
+// Volume files, OpenVDB side: with vdb_upsample.cpp, the only code of the library that includes OpenVDB (it
+// compiles slowly). Built into the module libnimbus_openvdb.so, or linked in (io/vdb_internal.h says when).
 // Reads .vdb grids, converts float grids to NanoVDB once, and lists grids for `nimbus info`.
 // Every OpenVDB exception (and bad_alloc from a corrupt size field) becomes a nimbus::Error naming the file.
 #include <fmt/format.h>
