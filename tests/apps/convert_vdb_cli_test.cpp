@@ -34,13 +34,9 @@ TEST(ConvertCli, VdbBecomesAnEquivalentNvdb) {
   EXPECT_NE(b.find("active voxels 25"), std::string::npos) << b;
   // The same image from either file.
   for (const char* f : {"a", "b"}) {
-    std::ofstream(dir / (std::string(f) + ".json"))
-        << R"({"camera": {"position": [0.25, -5, -0.25], "look_at": [0.25, 0, -0.25], "up": [0, 0, 1],
-          "fov_y_deg": 35, "width": 8, "height": 6},
-          "media": [{"shape": {"type": "vdb", "file": ")"
-        << (f[0] == 'a' ? vdb.string() : (dir / "t.nvdb").string()) << R"("}, "sigma_s": 4.0}],
-          "lights": [{"type": "directional", "direction": [1, 1, -1], "irradiance": 2.0}],
-          "integrator": {"type": "pathtrace", "spp": 2}})";
+    test::write_vdb_scene(dir / (std::string(f) + ".json"),
+                          f[0] == 'a' ? vdb.string() : (dir / "t.nvdb").string(), 8, 6,
+                          R"({"type": "pathtrace", "spp": 2})");
     ASSERT_EQ(run_cli("render --quiet " + (dir / (std::string(f) + ".json")).string() + " -o " +
                       (dir / (std::string(f) + ".exr")).string())
                   .rc,
@@ -81,12 +77,7 @@ TEST(ConvertCli, UpsampleRefinesTheGridAndRefusesBadFactors) {
   }
   EXPECT_FALSE(fs::exists(dir / "x.nvdb"));
   // An image conversion takes no factor.
-  std::ofstream(dir / "a.json") << R"({"camera": {"position": [0.25, -5, -0.25], "look_at": [0.25, 0, -0.25],
-      "up": [0, 0, 1], "fov_y_deg": 35, "width": 4, "height": 3},
-      "media": [{"shape": {"type": "vdb", "file": ")"
-                                << vdb.string() << R"("}, "sigma_s": 4.0}],
-      "lights": [{"type": "directional", "direction": [1, 1, -1], "irradiance": 2.0}],
-      "integrator": {"type": "pathtrace", "spp": 1}})";
+  test::write_vdb_scene(dir / "a.json", vdb.string(), 4, 3, R"({"type": "pathtrace", "spp": 1})");
   ASSERT_EQ(run_cli("render --quiet " + (dir / "a.json").string() + " -o " + (dir / "a.exr").string()).rc, 0);
   const test::CliRun r =
       run_cli("convert " + (dir / "a.exr").string() + " " + (dir / "x.png").string() + " --upsample 2");

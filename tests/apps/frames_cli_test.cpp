@@ -19,13 +19,8 @@ namespace {
 namespace fs = std::filesystem;
 
 void write_vdb_scene(const fs::path& file, const std::string& volume) {
-  std::ofstream(file) << R"({"camera": {"position": [0.25, -5, -0.25], "look_at": [0.25, 0, -0.25],
-    "up": [0, 0, 1], "fov_y_deg": 35, "width": 10, "height": 8},
-    "media": [{"shape": {"type": "vdb", "file": ")"
-                      << volume << R"("}, "sigma_s": 4.0}],
-    "lights": [{"type": "directional", "direction": [1, 1, -1], "irradiance": 2.0},
-               {"type": "environment", "radiance": 0.2}],
-    "integrator": {"type": "pathtrace", "spp": 2}})";
+  test::write_vdb_scene(file, volume, 10, 8, R"({"type": "pathtrace", "spp": 2})",
+                        R"(, {"type": "environment", "radiance": 0.2})");
 }
 
 using test::meta_value;

@@ -22,12 +22,7 @@ TEST(OpenVdbModule, LoadedOnlyForVdbFilesAndMissingItIsAClearError) {
   const fs::path vdb = fs::path(NIMBUS_SOURCE_DIR) / "fuzz" / "data" / "tiny.vdb";
   const fs::path nvdb = dir / "t.nvdb";
   ASSERT_EQ(test::run_cli("convert " + vdb.string() + " " + nvdb.string()).rc, 0);
-  std::ofstream(dir / "s.json") << R"({"camera": {"position": [0.25, -5, -0.25], "look_at": [0.25, 0, -0.25],
-      "up": [0, 0, 1], "fov_y_deg": 35, "width": 8, "height": 6},
-      "media": [{"shape": {"type": "vdb", "file": ")"
-                                << nvdb.string() << R"("}, "sigma_s": 4.0}],
-      "lights": [{"type": "directional", "direction": [1, 1, -1], "irradiance": 2.0}],
-      "integrator": {"type": "mfs", "spp": 1}})";
+  test::write_vdb_scene(dir / "s.json", nvdb.string(), 8, 6, R"({"type": "mfs", "spp": 1})");
   const std::string missing = (dir / "no_such_module.so").string();
   const std::string env = "NIMBUS_OPENVDB_MODULE=" + missing + " ";
   // A NanoVDB scene and file never need OpenVDB.

@@ -44,6 +44,21 @@ inline int run_cli_status(const std::string& args) {
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
+// A scene of one .vdb or .nvdb volume `volume` (sigma_s 4, framed for fuzz/data/tiny.vdb) under a
+// directional light, then `extra_lights` (JSON objects, each preceded by a comma).
+inline void write_vdb_scene(const std::filesystem::path& file, const std::string& volume, int width,
+                            int height, const std::string& integrator, const std::string& extra_lights = "") {
+  std::ofstream(file) << R"({"camera": {"position": [0.25, -5, -0.25], "look_at": [0.25, 0, -0.25],
+    "up": [0, 0, 1], "fov_y_deg": 35, "width": )"
+                      << width << R"(, "height": )" << height << R"(},
+    "media": [{"shape": {"type": "vdb", "file": ")"
+                      << volume << R"("}, "sigma_s": 4.0}],
+    "lights": [{"type": "directional", "direction": [1, 1, -1], "irradiance": 2.0})"
+                      << extra_lights << R"(],
+    "integrator": )" << integrator
+                      << "}";
+}
+
 inline std::string slurp(const std::filesystem::path& p) {
   std::ifstream in(p);
   std::stringstream ss;
