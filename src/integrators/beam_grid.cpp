@@ -3,6 +3,7 @@
 #include "integrators/beam_grid.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -12,9 +13,10 @@
 namespace nimbus {
 namespace {
 
-// Per node: traced (rgb), traced x mean cosine (rgb), straight (rgb), and with a camera (peak_toward)
-// traced x P_peak towards the camera (rgb).
-constexpr int kBaseFloats = 9, kCameraFloats = 12;
+// Per node, in blocks of `channels` floats (3: rgb; 1: grey media under lights of grey strength, whose
+// three channels would be the same numbers): traced, traced x mean cosine, straight, and with a camera
+// (peak_toward) traced x P_peak towards the camera.
+constexpr int kBaseBlocks = 3, kCameraBlocks = 4;
 constexpr double kR2a1 = 0.75487766624669276, kR2a2 = 0.56984029099805327;  // the R2 sequence
 constexpr double kRoulette = 0.05;  // roulette below this ratio of weight to T_wide
 // Deposit samples (and the loss's midpoint rule) at most this many node spacings apart: 1 (0.5 before,
@@ -27,20 +29,21 @@ constexpr double kDepositStep = 1.0;
 // Which columns a deposit sample goes to.
 enum class Columns { traced, straight, both };
 
-// Adds v (channel ch) with trilinear weights st to the tally: to the straight column, to the traced one
-// and (times mu) the traced x cosine one, or to all three.
-// stride: floats per node; pk: P_peak towards the camera (stride kCameraFloats only).
-void splat(float* tally, int stride, const TrilinearStencil& st, int ch, double v, double mu, double pk,
-           Columns to) {
+// Adds v (channel ch of `channels`) with trilinear weights st to the tally: to the straight column, to
+// the traced one and (times mu) the traced x cosine one, or to all three; with_pk: also pk (P_peak
+// towards the camera) to the fourth column.
+void splat(float* tally, int channels, bool with_pk, const TrilinearStencil& st, int ch, double v, double mu,
+           double pk, Columns to) {
+  const int stride = channels * (with_pk ? kCameraBlocks : kBaseBlocks);
   for (int j = 0; j < 8; ++j)
     if (st.weight[j] > 0.0) {
-      float* node = &tally[st.node[j] * stride];
+      float* node = &tally[st.node[j] * stride + ch];
       const double x = st.weight[j] * v;
-      if (to != Columns::traced) node[6 + ch] += float(x);
+      if (to != Columns::traced) node[2 * channels] += float(x);
       if (to != Columns::straight) {
-        node[ch] += float(x);
-        node[3 + ch] += float(x * mu);
-        if (stride == kCameraFloats) node[9 + ch] += float(x * pk);
+        node[0] += float(x);
+        node[channels] += float(x * mu);
+        if (with_pk) node[3 * channels] += float(x * pk);
       }
     }
 }
@@ -91,6 +94,19 @@ std::vector<uint8_t> idle_cells(const NodeGrid& g, const MajorantGrid& maj) {
   return idle;
 }
 
+// True when every directional and point light's photons carry the same weight in all three channels (a
+// strength with no channel at 0, or none at all): with grey media the beam grid's three channels are then
+// the same numbers (the same bits under white light), and it keeps one.
+bool grey_lights(const SceneContext& ctx) {
+  for (const Light& light : ctx.lights) {
+    Rgb s(0.0);
+    if (const auto* d = std::get_if<DirectionalLight>(&light)) s = d->irradiance;
+    if (const auto* p = std::get_if<PointLight>(&light)) s = p->intensity;
+    if (!((s.x > 0.0 && s.y > 0.0 && s.z > 0.0) || max_component(s) <= 0.0)) return false;
+  }
+  return true;
+}
+
 // One photon's state: the channel whose coefficients drive it, its weight and its weight at emission.
 struct BeamWalk {
   int c;
@@ -117,7 +133,7 @@ struct BeamPhotons {
   double radius;
   double majorant_scale;             // the share of the majorant that bounds the peak-scatter rate
   const Vec3* camera;                // tally P_peak (of medium 0) towards this point, or null
-  int stride;                        // floats per node
+  int channels;                      // floats per column of a node: 3, or 1 (channel 0 stands for all)
   const MajorantGrid* majorants;     // the photons' tracking majorants (null: the scene's)
   const std::vector<uint8_t>& idle;  // per cell of the node grid: see idle_cells
 
@@ -156,11 +172,11 @@ void BeamPhotons::sample(float* tally, const Vec3& q, const Vec3& w, double dl, 
   // The peak-only light's last peak scatter towards the camera (the forward-peak term's angular factor).
   const double pk = camera && traced ? splits[0]->peak(dot(w, normalize(*camera - q))) : 0.0;
   const TrilinearStencil st = grid.stencil(q);
-  for (int ch = 0; ch < 3; ++ch) {
+  for (int ch = 0; ch < channels; ++ch) {
     if ((!grey && ch != c) || !(tw[ch] > 1e-30)) continue;
     const double v = mid[ch] * dl / (tw[ch] * geo);
     NIMBUS_DCHECK(v >= 0.0 && std::isfinite(v));
-    splat(tally, stride, st, ch, v, mu, pk, to);
+    splat(tally, channels, camera != nullptr, st, ch, v, mu, pk, to);
   }
 }
 
@@ -285,13 +301,15 @@ BeamGrid::BeamGrid(const SceneContext& ctx, const std::vector<const PhaseSplit*>
                    const std::vector<double>& peak_fraction,
                    const std::vector<TransmittanceGrid>& reduced_maps, int photons, int resolution,
                    uint64_t seed, const Vec3* camera, const MajorantGrid* majorants, bool skip_idle)
-    : stride_(camera ? kCameraFloats : kBaseFloats) {
+    : with_camera_(camera != nullptr) {
   if (camera) camera_ = *camera;
   values_.resize(ctx.lights.size());
   const Bounds media_bounds = ctx.media.bounds();
   if (media_bounds.empty() || photons <= 0 || reduced_maps.size() != ctx.lights.size()) return;
   grid_ = node_grid_padded(media_bounds, resolution);
   const bool grey = grey_media(ctx);
+  channels_ = grey && grey_lights(ctx) ? 1 : 3;
+  stride_ = channels_ * (camera ? kCameraBlocks : kBaseBlocks);
   // Chromatic media: one pass per channel, the light's photons shared among them (a third each: the
   // suite's chromatic box had the same error with a third as with all three times over, at 0.8x the
   // set-up; docs/benchmarks.md).
@@ -325,7 +343,7 @@ BeamGrid::BeamGrid(const SceneContext& ctx, const std::vector<const PhaseSplit*>
                            .radius = radius,
                            .majorant_scale = scale,
                            .camera = camera ? &camera_ : nullptr,
-                           .stride = stride_,
+                           .channels = channels_,
                            .majorants = majorants,
                            .idle = idle};
     // The batches' sums divided by the node volume.
@@ -345,19 +363,25 @@ bool BeamGrid::lookup(size_t light, const Vec3& p, const TrilinearStencil& st, R
                       Rgb* peak_toward) const {
   if (light >= values_.size() || values_[light].empty() || !grid_.bounds.contains(p)) return false;
   const FloatArray& v = values_[light];
+  const int n = channels_;
   Rgb r(0.0), m(0.0), straight(0.0), pk(0.0);
   for (int k = 0; k < 8; ++k)
-    for (int c = 0; c < 3; ++c) {
-      const float* node = &v[st.node[k] * size_t(stride_)];
-      r[c] += st.weight[k] * node[c];
-      m[c] += st.weight[k] * node[3 + c];
-      straight[c] += st.weight[k] * node[6 + c];
-      if (stride_ == kCameraFloats) pk[c] += st.weight[k] * node[9 + c];
+    for (int c = 0; c < n; ++c) {
+      const float* node = &v[st.node[k] * size_t(stride_) + c];
+      r[c] += st.weight[k] * node[0];
+      m[c] += st.weight[k] * node[n];
+      straight[c] += st.weight[k] * node[2 * n];
+      if (with_camera_) pk[c] += st.weight[k] * node[3 * n];
     }
-  for (int c = 0; c < 3; ++c) {
+  for (int c = 0; c < n; ++c) {
     (*factor)[c] = straight[c] > 0.0 ? r[c] / straight[c] : 1.0;
     (*mean_cosine)[c] = r[c] > 0.0 ? std::clamp(m[c] / r[c], -1.0, 1.0) : 1.0;
     if (peak_toward) (*peak_toward)[c] = r[c] > 0.0 ? pk[c] / r[c] : 0.0;
+  }
+  if (n == 1) {  // channel 0 stands for all three
+    *factor = Rgb((*factor)[0]);
+    *mean_cosine = Rgb((*mean_cosine)[0]);
+    if (peak_toward) *peak_toward = Rgb((*peak_toward)[0]);
   }
   return true;
 }

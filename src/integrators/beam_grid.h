@@ -49,7 +49,10 @@ class BeamGrid {
   bool lookup(size_t light, const Vec3& p, const TrilinearStencil& st, Rgb* factor, Rgb* mean_cosine,
               Rgb* peak_toward = nullptr) const;
   const NodeGrid& node_grid() const { return grid_; }
-  bool has_camera() const { return stride_ > 9; }
+  bool has_camera() const { return with_camera_; }
+  // Floats per column of a node: 1 where grey media and grey lights make the three channels the same
+  // numbers (channel 0 is kept and stands for all), else 3.
+  int channels() const { return channels_; }
   size_t memory_bytes() const;
   // Peak scatters whose direction the rejection sampler could not draw (the photon flew on
   // undeflected; see sample_by_rejection). 0 in every normal case.
@@ -59,11 +62,13 @@ class BeamGrid {
 
  private:
   NodeGrid grid_;                   // the media's bounds padded by one spacing (node_grid_padded)
-  std::vector<FloatArray> values_;  // per light and node: traced, traced x cosine, straight (rgb)
+  std::vector<FloatArray> values_;  // per light and node: traced, traced x cosine, straight (, P_peak)
   uint64_t rejection_failures_ = 0;
   double idle_share_ = 0.0;
-  int stride_;        // floats per node
-  Vec3 camera_{0.0};  // the point P_peak is tallied towards (with stride_ 12)
+  bool with_camera_;  // the nodes hold a fourth column, P_peak towards camera_
+  int channels_ = 3;  // floats per column
+  int stride_ = 0;    // floats per node
+  Vec3 camera_{0.0};  // the point P_peak is tallied towards
 };
 
 }  // namespace nimbus

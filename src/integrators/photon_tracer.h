@@ -48,9 +48,18 @@ Photon emit(const SceneContext& ctx, size_t source, const Vec3& c, double r, dou
 // True when every medium's sigma_s and sigma_a are equal in all channels (one photon pass carries RGB).
 bool grey_media(const SceneContext& ctx);
 
+// A batch's share of the tallies: `size` floats, zero at the start.
+struct TallyView {
+  float* values = nullptr;
+  size_t count = 0;
+  float* data() const { return values; }
+  size_t size() const { return count; }
+  float& operator[](size_t i) const { return values[i]; }
+};
+
 // What one batch of photons has written and spent.
 struct PhotonBatch {
-  ZeroedFloats tally;               // the grid's per-node sums, laid out as the grid wants (zero at start)
+  TallyView tally;                  // the grid's per-node sums, laid out as the grid wants (zero at start)
   double collisions = 0.0;          // real collisions so far (the work budget's measure)
   uint64_t rejection_failures = 0;  // scatters whose direction sample_by_rejection could not draw
 };

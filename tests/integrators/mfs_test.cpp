@@ -643,6 +643,58 @@ TEST(Mfs, BeamGridSkipsIdleCellsWithoutChangingTheMedia) {
   EXPECT_GT(gap_differs, gap / 2);
 }
 
+// Grey media under lights of grey strength keep one channel per column (the three would be the same
+// numbers), and it must read as the three-channel layout does: a light with its blue channel at 0 keeps
+// three channels, and its red channel (the same strength, so the same photons and weights) must give
+// every channel of the one-channel grid, bit for bit, with the camera column and without.
+TEST(Mfs, BeamGridKeepsOneChannelForGreyMediaAndGreyLights) {
+  const auto scene_with = [](const std::string& irradiance, const std::string& sigma_s) {
+    return test::scene_from_json("{" + test::camera_json(8, 8) + R"(,
+      "media": [{"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1}, "sigma_s": )" +
+                                 sigma_s + R"(, "sigma_a": 0.05, "phase": {"type": "hg", "g": 0.85}}],
+      "lights": [{"type": "directional", "direction": [1, -0.3, 0.2], "irradiance": )" +
+                                 irradiance + "}]}");
+  };
+  const Scene grey = scene_with("[1, 0.5, 2]", "3.0"), blue0 = scene_with("[1, 0.5, 0]", "3.0");
+  const Scene chromatic = scene_with("[1, 0.5, 2]", "[3.0, 2.5, 2.0]");
+  MfsSettings ms = mfs_settings_from_json(nlohmann::json::object(), "test");
+  ms.large_angle_scatters = 0;
+  ms.beam_photons = 0;
+  const Vec3 cam(0.0, -6.0, 0.0);
+  const auto grid = [&](const Scene& scene, bool camera) {
+    const SceneContext ctx(scene);
+    const MfsIntegrator mfs(ctx, ms);
+    const std::vector<const PhaseSplit*> splits{&mfs.split(0)};
+    const std::vector<double> f{mfs.split(0).f()};
+    std::vector<TransmittanceGrid> maps;
+    for (const Light& light : ctx.lights) maps.emplace_back(ctx.media, ctx.majorants, light, 32, 0.25, f);
+    return BeamGrid(ctx, splits, f, maps, 4096, 24, 7, camera ? &cam : nullptr);
+  };
+  EXPECT_EQ(grid(chromatic, false).channels(), 3);
+  for (const bool camera : {false, true}) {
+    const BeamGrid one = grid(grey, camera), three = grid(blue0, camera);
+    ASSERT_EQ(one.channels(), 1);
+    ASSERT_EQ(three.channels(), 3);
+    EXPECT_LT(one.memory_bytes() * 2, three.memory_bytes());
+    Rng rng(3, 0);
+    int deflected = 0;
+    for (int i = 0; i < 2000; ++i) {
+      const double x = 2 * rng.uniform() - 1, y = 2 * rng.uniform() - 1, z = 2 * rng.uniform() - 1;
+      const Vec3 p(x, y, z);
+      Rgb R[2], mc[2], pk[2];
+      ASSERT_TRUE(one.lookup(0, p, &R[0], &mc[0], camera ? &pk[0] : nullptr));
+      ASSERT_TRUE(three.lookup(0, p, &R[1], &mc[1], camera ? &pk[1] : nullptr));
+      for (int c = 0; c < 3; ++c) {
+        EXPECT_EQ(R[0][c], R[1][0]) << "at " << x << " " << y << " " << z;
+        EXPECT_EQ(mc[0][c], mc[1][0]) << "at " << x << " " << y << " " << z;
+        if (camera) EXPECT_EQ(pk[0][c], pk[1][0]) << "at " << x << " " << y << " " << z;
+      }
+      deflected += R[0][0] != 1.0 && mc[0][0] < 1.0;
+    }
+    EXPECT_GT(deflected, 200);  // the lookups read tallies, not the empty grid's defaults
+  }
+}
+
 // Steps that grow with the camera-side depth (the default) give the image of fixed steps: the light
 // from deep in is attenuated and blurred, and the jittered march stays unbiased.
 TEST(Mfs, GrowingStepsMatchFixedSteps) {
