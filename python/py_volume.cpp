@@ -1,21 +1,18 @@
 // nimbus.Volume (docs/python.md, "Volumes"): a dense float32 numpy array becomes an OpenVDB grid (the
-// voxels equal to 0 left inactive), converted once to NanoVDB as a volume file is (io/vdb_openvdb.cpp:
-// openToNanoVDB), so that a scene renders it exactly as it renders the same grid written to a .vdb.
+// voxels equal to 0 left inactive), converted once to NanoVDB as a volume file is (io/vdb_openvdb_dense.cpp,
+// in the OpenVDB module, loaded on first use), so that a scene renders it exactly as it renders the same
+// grid written to a .vdb.
 #include <fmt/format.h>
-#include <nanovdb/util/OpenToNanoVDB.h>
-#include <openvdb/io/File.h>
-#include <openvdb/openvdb.h>
-#include <openvdb/tools/Dense.h>
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
 #include <array>
 #include <cmath>
 #include <filesystem>
-#include <mutex>
 #include <optional>
 
 #include "io/vdb.h"
+#include "io/vdb_internal.h"
 #include "media/density_grid.h"
 #include "nimbus/error.h"
 #include "py_common.h"
@@ -25,11 +22,6 @@ namespace nimbus::python {
 namespace {
 
 using FloatArray = py::array_t<float, py::array::c_style | py::array::forcecast>;
-
-void init_openvdb() {
-  static std::once_flag once;
-  std::call_once(once, [] { openvdb::initialize(); });
-}
 
 std::array<double, 3> voxel_sizes(const py::object& voxel_size) {
   std::array<double, 3> vs{};
@@ -46,36 +38,6 @@ std::array<double, 3> voxel_sizes(const py::object& voxel_size) {
   return vs;
 }
 
-// The OpenVDB grid of the array: voxel (i, j, k) of the index space is a[i - i0, j - j0, k - k0] for the
-// index offset (i0, j0, k0); index to world is the scale by the voxel size, then the translation `origin`.
-openvdb::FloatGrid::Ptr grid_from_dense(const FloatArray& a, const std::array<double, 3>& vs,
-                                        const std::array<double, 3>& origin, const std::array<int, 3>& offset,
-                                        const std::string& name) {
-  init_openvdb();
-  const openvdb::Coord lo(offset[0], offset[1], offset[2]);
-  const openvdb::Coord hi(offset[0] + int(a.shape(0)) - 1, offset[1] + int(a.shape(1)) - 1,
-                          offset[2] + int(a.shape(2)) - 1);
-  // LayoutZYX: z varies fastest, as in a C-ordered array indexed [x, y, z].
-  // Only read (copyFromDense), though Dense takes a mutable pointer.
-  openvdb::tools::Dense<float, openvdb::tools::LayoutZYX> dense(openvdb::CoordBBox(lo, hi),
-                                                                const_cast<float*>(a.data()));
-  auto grid = openvdb::FloatGrid::create(0.0f);
-  openvdb::math::Transform::Ptr xform;
-  if (vs[0] == vs[1] && vs[1] == vs[2]) {
-    xform = openvdb::math::Transform::createLinearTransform(vs[0]);
-  } else {
-    openvdb::math::Mat4d m = openvdb::math::Mat4d::identity();
-    m.preScale(openvdb::math::Vec3d(vs[0], vs[1], vs[2]));
-    xform = openvdb::math::Transform::createLinearTransform(m);
-  }
-  xform->postTranslate(openvdb::math::Vec3d(origin[0], origin[1], origin[2]));
-  grid->setTransform(xform);
-  grid->setName(name);
-  grid->setGridClass(openvdb::GRID_FOG_VOLUME);
-  openvdb::tools::copyFromDense(dense, *grid, 0.0f);
-  return grid;
-}
-
 using BoolArray = py::array_t<bool, py::array::c_style | py::array::forcecast>;
 
 // The first non-finite value's index, as an error (OpenVDB would take NaN for the background, 0).
@@ -88,18 +50,6 @@ void check_finite(const FloatArray& a) {
       throw Error(fmt::format("Volume: density[{}, {}, {}] is {} (values must be finite)", i / (ny * nz),
                               (i / nz) % ny, i % nz, p[i]));
     }
-}
-
-// Voxel activity from a mask of the array's shape (values kept: an inactive voxel still holds its value).
-void apply_active_mask(openvdb::FloatGrid& grid, const BoolArray& mask, const std::array<int, 3>& offset) {
-  auto acc = grid.getAccessor();
-  const bool* m = mask.data();
-  for (int i = 0; i < int(mask.shape(0)); ++i)
-    for (int j = 0; j < int(mask.shape(1)); ++j)
-      for (int k = 0; k < int(mask.shape(2)); ++k) {
-        const openvdb::Coord ijk(offset[0] + i, offset[1] + j, offset[2] + k);
-        if (*m++ != acc.isValueOn(ijk)) acc.setActiveState(ijk, m[-1]);
-      }
 }
 
 Volume make_volume(const FloatArray& a, const py::object& voxel_size, const std::array<double, 3>& origin,
@@ -121,14 +71,18 @@ Volume make_volume(const FloatArray& a, const py::object& voxel_size, const std:
   v.name = name;
   py::gil_scoped_release release;
   check_finite(a);
-  auto grid = grid_from_dense(a, vs, origin, index_offset, name);
-  if (active) apply_active_mask(*grid, *active, index_offset);
-  if (grid->activeVoxelCount() == 0) throw Error("Volume: every voxel is 0 (an empty grid)");
-  auto handle = nanovdb::openToNanoVDB<nanovdb::HostBuffer>(*grid, nanovdb::StatsMode::BBox,
-                                                            nanovdb::ChecksumMode::Disable);
+  const detail::DenseVolume dense{.values = a.data(),
+                                  .shape = {int(a.shape(0)), int(a.shape(1)), int(a.shape(2))},
+                                  .voxel_size = vs,
+                                  .origin = origin,
+                                  .index_offset = index_offset,
+                                  .name = name,
+                                  .active = active ? active->data() : nullptr};
+  detail::DenseGrid grid = detail::openvdb_grid_from_dense(dense);
+  if (grid.active_voxels == 0) throw Error("Volume: every voxel is 0 (an empty grid)");
   v.grid = std::make_shared<const DensityGrid>(
-      DensityGrid::from_nanovdb(std::move(handle), fmt::format("numpy volume '{}'", name)));
-  v.openvdb_grid = grid;
+      DensityGrid::from_nanovdb(std::move(grid.nano), fmt::format("numpy volume '{}'", name)));
+  v.openvdb_grid = std::move(grid.grid);
   return v;
 }
 
@@ -180,20 +134,8 @@ std::array<double, 3> voxel_size_of(const Volume& v) {
 
 void save_vdb(const Volume& v, const std::filesystem::path& path) {
   if (!v.openvdb_grid) throw Error("Volume.save: only a volume made from a numpy array can be saved");
-  const auto grid = std::static_pointer_cast<openvdb::FloatGrid>(v.openvdb_grid);
-  std::filesystem::path tmp = path;
-  tmp += ".tmp";
   py::gil_scoped_release release;
-  try {
-    openvdb::io::File file(tmp.string());
-    file.write({grid});
-    file.close();
-    std::filesystem::rename(tmp, path);
-  } catch (const std::exception& e) {
-    std::error_code ec;
-    std::filesystem::remove(tmp, ec);
-    throw Error(fmt::format("{}: cannot write: {}", path.string(), e.what()));
-  }
+  detail::save_openvdb_grid(v.openvdb_grid, path);
 }
 
 std::array<double, 3> tuple3(const Vec3& v) { return {v.x, v.y, v.z}; }

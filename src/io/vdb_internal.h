@@ -7,7 +7,9 @@
 #include <nanovdb/util/HostBuffer.h>
 
 #include <array>
+#include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -42,15 +44,42 @@ std::array<NanoHandle, 3> load_openvdb_vec3_grid(const std::filesystem::path& fi
 // Every grid of an OpenVDB file, for `nimbus info`.
 std::vector<GridInfo> inspect_openvdb_file(const std::filesystem::path& file);
 
-// The module's functions, as one table (the module exports nothing else: nimbus_openvdb_module()).
+// A volume made in memory (nimbus.Volume from a numpy array): values[i][j][k] (z fastest) of voxel
+// (i, j, k) + index_offset; world = origin + voxel_size * index. active: null (the non-zero voxels are
+// active) or a mask of the same layout.
+struct DenseVolume {
+  const float* values = nullptr;
+  std::array<int, 3> shape{};
+  std::array<double, 3> voxel_size{}, origin{};
+  std::array<int, 3> index_offset{};
+  std::string name;
+  const bool* active = nullptr;
+};
+// Its OpenVDB float grid (a fog volume, 0 background, to keep for writing it out) and that grid converted
+// to NanoVDB as a .vdb file's grid is (no NanoVDB grid when no voxel is active).
+struct DenseGrid {
+  std::shared_ptr<void> grid;  // the openvdb::FloatGrid
+  NanoHandle nano;
+  uint64_t active_voxels = 0;
+};
+DenseGrid openvdb_grid_from_dense(const DenseVolume& volume);
+// Writes a DenseGrid's grid as the .vdb file `path` (through `path`.tmp; errors name `path`).
+void save_openvdb_grid(const std::shared_ptr<void>& grid, const std::filesystem::path& path);
+
+// The module's side of the five functions above (vdb_openvdb.cpp, vdb_openvdb_dense.cpp), as one table
+// (the module exports nothing else: nimbus_openvdb_module()).
 struct OpenVdbModule {
   int abi;  // kOpenVdbModuleAbi of the build that made it
   NanoHandle (*load_float_grid)(const std::filesystem::path&, const std::string&, int);
   std::array<NanoHandle, 3> (*load_vec3_grid)(const std::filesystem::path&, const std::string&);
   std::vector<GridInfo> (*inspect_file)(const std::filesystem::path&);
+  DenseGrid (*grid_from_dense)(const DenseVolume&);
+  void (*save_grid)(const std::shared_ptr<void>&, const std::filesystem::path&);
 };
 // Raised whenever OpenVdbModule or the types it passes change shape.
-inline constexpr int kOpenVdbModuleAbi = 1;
+inline constexpr int kOpenVdbModuleAbi = 2;
+DenseGrid dense_to_openvdb(const DenseVolume& volume);
+void write_openvdb_grid(const std::shared_ptr<void>& grid, const std::filesystem::path& path);
 
 // Voxel index coordinates must lie in [-2^30, 2^30): far inside int32, so node and bbox arithmetic
 // (origin + node size, max + 1) cannot overflow.

@@ -1,4 +1,4 @@
-// Volume files, OpenVDB side: with vdb_upsample.cpp, the only code of the library that includes OpenVDB (it
+// Volume files, OpenVDB side: with vdb_upsample.cpp and vdb_openvdb_dense.cpp, the only code of the library that includes OpenVDB (it
 // compiles slowly). Built into the module libnimbus_openvdb.so, or linked in (io/vdb_internal.h says when).
 // Reads .vdb grids, converts float grids to NanoVDB once, and lists grids for `nimbus info`.
 // Every OpenVDB exception (and bad_alloc from a corrupt size field) becomes a nimbus::Error naming the file.
@@ -308,11 +308,13 @@ static std::vector<GridInfo> file_grids(const std::filesystem::path& path) {
 
 }  // namespace nimbus::detail
 
-// The module's one export (io/vdb_internal.h): the table of the three functions above.
+// The module's one export (io/vdb_internal.h): the table of the three functions above and of
+// vdb_openvdb_dense.cpp's two.
 extern "C" __attribute__((visibility("default"))) const nimbus::detail::OpenVdbModule*
 nimbus_openvdb_module() {
   static constexpr nimbus::detail::OpenVdbModule table{
-      nimbus::detail::kOpenVdbModuleAbi, &nimbus::detail::float_grid, &nimbus::detail::vec3_grid,
-      &nimbus::detail::file_grids};
+      nimbus::detail::kOpenVdbModuleAbi, &nimbus::detail::float_grid,
+      &nimbus::detail::vec3_grid,        &nimbus::detail::file_grids,
+      &nimbus::detail::dense_to_openvdb, &nimbus::detail::write_openvdb_grid};
   return &table;
 }

@@ -1,6 +1,6 @@
-// Volume files, the way to the OpenVDB side (io/vdb_internal.h says why it is a module): the three
+// Volume files, the way to the OpenVDB side (io/vdb_internal.h says why it is a module): the five
 // detail::*openvdb* functions call the table of libnimbus_openvdb.so, loaded on first use. Where the
-// OpenVDB side is linked into the program (the tests, the Python module, the sanitizer builds) they call
+// OpenVDB side is linked into the program (the tests, the sanitizer builds) they call
 // it directly.
 #include <fmt/format.h>
 
@@ -77,15 +77,17 @@ Loaded load_module() {
 }
 #endif
 
-// The table, or a nimbus::Error naming `file` and why the module could not be loaded.
-const OpenVdbModule& module_for(const std::filesystem::path& file) {
+// The table, or a nimbus::Error naming `file` (what needs the module), what it could not do and why the
+// module could not be loaded.
+const OpenVdbModule& module_for(const std::filesystem::path& file,
+                                const char* action = "cannot read an OpenVDB file") {
 #if NIMBUS_LAZY_OPENVDB
   if (nimbus_openvdb_module != nullptr) return *nimbus_openvdb_module();
   static const Loaded loaded = load_module();
-  if (loaded.table == nullptr) fail(file, "cannot read an OpenVDB file: " + loaded.error);
+  if (loaded.table == nullptr) fail(file, fmt::format("{}: {}", action, loaded.error));
   return *loaded.table;
 #else
-  (void)file;
+  (void)file, (void)action;
   return *nimbus_openvdb_module();
 #endif
 }
@@ -104,6 +106,15 @@ std::array<NanoHandle, 3> load_openvdb_vec3_grid(const std::filesystem::path& fi
 
 std::vector<GridInfo> inspect_openvdb_file(const std::filesystem::path& file) {
   return module_for(file).inspect_file(file);
+}
+
+DenseGrid openvdb_grid_from_dense(const DenseVolume& volume) {
+  const OpenVdbModule& m = module_for(fmt::format("numpy volume '{}'", volume.name), "cannot make its grid");
+  return m.grid_from_dense(volume);
+}
+
+void save_openvdb_grid(const std::shared_ptr<void>& grid, const std::filesystem::path& path) {
+  module_for(path, "cannot write an OpenVDB file").save_grid(grid, path);
 }
 
 }  // namespace nimbus::detail

@@ -1,5 +1,7 @@
 """nimbus.Volume: a numpy array renders bit for bit as the same grid read from a .vdb file."""
 import os
+import subprocess
+import sys
 import tempfile
 import unittest
 
@@ -123,6 +125,38 @@ class NumpyVolume(unittest.TestCase):
         r = cli("render", path, "-o", os.path.join(self.dir, "v.exr"), check=False)
         self.assertEqual(r.returncode, 2)
         self.assertIn("/media/0/shape/volume", r.stderr)
+
+    def test_openvdb_is_loaded_only_for_volumes(self):
+        """`import nimbus` and a render without volumes leave OpenVDB unloaded (its module is loaded on
+        first use); a numpy volume loads it; without the module, making one is an error that names it."""
+        code = """
+import sys, numpy as np
+sys.path.insert(0, %r)
+from test_volume import blob, scene_with
+import nimbus
+def openvdb_loaded():
+    return any("libopenvdb" in line for line in open("/proc/self/maps"))
+doc = scene_with({"type": "sphere", "center": [0, 0, 0], "radius": 1})
+nimbus.render(doc)
+print("after render", openvdb_loaded())
+try:
+    vol = nimbus.Volume(blob(6), name="puff")
+except nimbus.Error as e:
+    print("error", e)
+    sys.exit(0)
+print("after volume", openvdb_loaded())
+""" % os.path.dirname(os.path.abspath(__file__))
+        r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        if os.environ.get("NIMBUS_TEST_LAZY_OPENVDB", "1") == "0":
+            self.skipTest("OpenVDB is linked in (a build with NIMBUS_LAZY_OPENVDB off)")
+        self.assertIn("after render False", r.stdout)
+        self.assertIn("after volume True", r.stdout)
+        env = dict(os.environ, NIMBUS_OPENVDB_MODULE=os.path.join(self.dir, "no-such-module.so"))
+        r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120, env=env)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertIn("error numpy volume 'puff': cannot make its grid", r.stdout)
+        self.assertIn("no-such-module.so", r.stdout)
 
 
 if __name__ == "__main__":
