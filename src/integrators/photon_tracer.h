@@ -105,28 +105,36 @@ void walk_photon(const SceneContext& ctx, const MajorantGrid& majorants, Vec3 x,
                  double majorant_scale, Rng& rng, double* collisions, Sigma&& sigma, OnFlight&& on_flight,
                  OnCollision&& on_collision, OnSurface&& on_surface) {
   constexpr double kInf = std::numeric_limits<double>::infinity();
+  // Constant-density shapes: over their pieces (one exponential step per collision, as `pathtrace`
+  // does), not cell by cell of the scene's majorant grid (one per cell crossed).
+  const bool pieces = ctx.analytic.active() && &majorants == &ctx.majorants;
   for (int events = 0; events < kMaxPhotonEvents; ++events, *collisions += 1.0) {
     bool hit = false;
     Vec3 xc;
     SurfaceHit surface;
     const bool to_surface = ctx.surfaces.intersect(x, w, kInf, &surface);
-    const bool reached =
-        track(majorants, x, w, surface.t, majorant_scale, rng, [&](const Vec3& p, double maj) {
-          bool real;
-          if constexpr (std::is_invocable_r_v<bool, Sigma, const Vec3&, double>) {
-            real = sigma(p, maj);
-          } else {
-            const double s = sigma(p);
-            NIMBUS_DCHECK(s >= 0.0 && s <= maj);  // a real collision's probability s / maj in [0, 1]
-            real = rng.uniform() * maj < s;
-          }
-          if (real) {
-            hit = true;
-            xc = p;
-            return false;
-          }
-          return true;
-        });
+    const auto visit = [&](auto&& segment) {
+      if (pieces)
+        ctx.analytic.traverse(x, w, surface.t, segment);
+      else
+        majorants.traverse(x, w, 0.0, surface.t, segment);
+    };
+    const bool reached = track_segments(visit, x, w, majorant_scale, rng, [&](const Vec3& p, double maj) {
+      bool real;
+      if constexpr (std::is_invocable_r_v<bool, Sigma, const Vec3&, double>) {
+        real = sigma(p, maj);
+      } else {
+        const double s = sigma(p);
+        NIMBUS_DCHECK(s >= 0.0 && s <= maj);  // a real collision's probability s / maj in [0, 1]
+        real = rng.uniform() * maj < s;
+      }
+      if (real) {
+        hit = true;
+        xc = p;
+        return false;
+      }
+      return true;
+    });
     if (reached && to_surface) {
       on_flight(x, w, surface.t);
       if (!on_surface(surface, &w)) return;

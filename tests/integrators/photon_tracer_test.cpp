@@ -4,7 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <atomic>
+#include <cmath>
 
 #include "integrators/mfs.h"
 #include "support/scenes.h"
@@ -44,6 +46,53 @@ TEST(PhotonTracer, WorkBudgetScalesTheTracedPhotonsToThePlannedOnes) {
       &failures);
   EXPECT_EQ(traced.load(), size_t(kPhotonBatches * 3));
   EXPECT_NEAR(sum[0], double(total), 1e-4);
+}
+
+// The walker's first flight through a constant-density sphere, over the shapes' pieces (the default for
+// such media) and cell by cell of the majorant grid: the share of photons with a real collision is
+// 1 - exp(-sigma 2 r) on a chord through the centre, and the mean distance to it is analytic, for real
+// collisions at the full extinction (majorant scale 1) and at a third of it (scale 1/3, the beam grid's
+// kind of density). Binomial and exponential standard errors, 4 of them.
+TEST(PhotonTracer, FirstFlightThroughASphereIsExponential) {
+  const Scene scene = test::scene_from_json("{" + test::camera_json(8, 8) + R"(,
+    "media": [{"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1}, "sigma_s": 0.9, "sigma_a": 0.1}],
+    "lights": [{"type": "directional", "direction": [1, 0, 0], "irradiance": 1.0}]})");
+  const SceneContext pieces(scene);
+  SceneContext cells(scene);
+  ASSERT_TRUE(pieces.analytic.active());
+  cells.analytic = AnalyticMedia();
+  constexpr int kPhotons = 40000;
+  for (const SceneContext* ctx : std::array<const SceneContext*, 2>{&pieces, &cells})
+    for (const double share : {1.0, 1.0 / 3.0}) {
+      const double sigma = 1.0 * share, chord = 2.0;
+      int hits = 0;
+      double depth = 0.0;
+      double collisions = 0.0;
+      for (int j = 0; j < kPhotons; ++j) {
+        Rng rng(11, uint64_t(j));
+        // Across the chord's length: the entry slightly off the axis (the sphere's chord is ~2 there).
+        const Vec3 x(-3.0, 1e-3 * (rng.uniform() - 0.5), 0.0);
+        double t_first = 0.0;
+        bool hit = false;
+        walk_photon(
+            *ctx, ctx->majorants, x, Vec3(1, 0, 0), share, rng, &collisions,
+            [&](const Vec3&) { return sigma; }, [&](const Vec3&, const Vec3&, double t) { t_first = t; },
+            [&](const Vec3&, Vec3*) { return hit = true, false; },
+            [](const SurfaceHit&, Vec3*) { return false; });
+        if (hit) ++hits, depth += t_first - 2.0;  // the sphere starts 2 from x
+      }
+      const double p = 1.0 - std::exp(-sigma * chord);
+      const double share_hit = double(hits) / kPhotons;
+      EXPECT_NEAR(share_hit, p, 4.0 * std::sqrt(p * (1.0 - p) / kPhotons)) << "scale " << share;
+      // The depth of a collision on the chord: an exponential truncated at the chord's length.
+      const double e = std::exp(-sigma * chord);
+      const double mean = (1.0 / sigma - e * (chord + 1.0 / sigma)) / (1.0 - e);
+      const double m2 =
+          (2.0 / (sigma * sigma) - e * (chord * chord + 2.0 * chord / sigma + 2.0 / (sigma * sigma))) /
+          (1.0 - e);
+      const double se = std::sqrt((m2 - mean * mean) / hits);
+      EXPECT_NEAR(depth / hits, mean, 4.0 * se) << "scale " << share;
+    }
 }
 
 TEST(PhotonTracer, RejectionFailureIsExplicitAndKeepsTheDirection) {
