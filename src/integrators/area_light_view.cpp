@@ -57,4 +57,21 @@ void marched_full_and_reduced(const SceneContext& ctx, const Vec3& p, const Vec3
   *T_reduced = exp(-tau_reduced);
 }
 
+bool chord_full_and_reduced(const SceneContext& ctx, const Vec3& p, const Vec3& w, double tmax,
+                            const std::vector<double>& peak_fraction, Rgb* T_full, Rgb* T_reduced) {
+  if (!ctx.analytic.active() || ctx.media.count() != 1) return false;
+  double t0 = 0.0, t1 = 0.0;
+  if (!ctx.analytic.chord(0, p, w, tmax, &t0, &t1) || !(t1 > t0)) {
+    *T_full = *T_reduced = Rgb(1.0);
+    return true;
+  }
+  MediumPoint m;
+  ctx.media.eval(p + w * (0.5 * (t0 + t1)), &m);
+  const Rgb sigma_t = m.sigma_t();
+  const Rgb sigma_red = peak_fraction.empty() ? sigma_t : sigma_t - m.sigma_s_i[0] * peak_fraction[0];
+  *T_full = exp(-sigma_t * (t1 - t0));
+  *T_reduced = exp(-sigma_red * (t1 - t0));
+  return true;
+}
+
 }  // namespace nimbus

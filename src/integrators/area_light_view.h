@@ -30,4 +30,10 @@ void marched_full_and_reduced(const SceneContext& ctx, const Vec3& p, const Vec3
                               double tau_step, const std::vector<double>& peak_fraction, Rgb* T_full,
                               Rgb* T_reduced);
 
+// The same two in closed form where the scene's media are one constant-density sphere or box
+// (ctx.analytic active, one medium): its chord along w over (0, tmax). False (nothing written) for any
+// other scene.
+bool chord_full_and_reduced(const SceneContext& ctx, const Vec3& p, const Vec3& w, double tmax,
+                            const std::vector<double>& peak_fraction, Rgb* T_full, Rgb* T_reduced);
+
 }  // namespace nimbus

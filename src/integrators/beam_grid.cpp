@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "core/check.h"
+#include "integrators/area_light_view.h"
 #include "integrators/photon_tracer.h"
 
 namespace nimbus {
@@ -121,7 +122,8 @@ struct BeamPhotons {
   const SceneContext& ctx;
   const std::vector<const PhaseSplit*>& splits;
   const std::vector<double>& peak_fraction;
-  const TransmittanceGrid& T_wide;  // the light's reduced shadow map
+  const TransmittanceGrid& T_wide;  // the light's reduced shadow map (empty: the closed-form chord)
+  bool chord;                       // T_wide by the chord (one constant-density shape: an empty map)
   const NodeGrid& grid;
   size_t light;
   const PointLight* point;  // or null: a directional light
@@ -137,12 +139,26 @@ struct BeamPhotons {
   const MajorantGrid* majorants;     // the photons' tracking majorants (null: the scene's)
   const std::vector<uint8_t>& idle;  // per cell of the node grid: see idle_cells
 
+  // T_wide from q to the light: the map, or the chord.
+  Rgb wide(const Vec3& q) const;
   void trace(size_t j, Rng& rng, PhotonBatch& batch) const;
   void sample(float* tally, const Vec3& q, const Vec3& w, double dl, Rgb* weight, int c, Columns to) const;
   Rgb deposit(float* tally, const Vec3& x, const Vec3& w, double t_end, Rgb weight, int c) const;
   Rgb deposit_first(float* tally, const Vec3& x, const Vec3& w, double t_end, Rgb weight, int c) const;
   bool scatter(const Vec3& xc, Vec3* w, BeamWalk& walk, Rng& rng, PhotonBatch& batch) const;
 };
+
+Rgb BeamPhotons::wide(const Vec3& q) const {
+  if (!chord) return T_wide.lookup(q);
+  Rgb full, reduced;
+  const double inf = std::numeric_limits<double>::infinity();
+  const bool done =
+      point ? chord_full_and_reduced(ctx, q, normalize(point->position - q), (point->position - q).length(),
+                                     peak_fraction, &full, &reduced)
+            : chord_full_and_reduced(ctx, q, -dir_w, inf, peak_fraction, &full, &reduced);
+  NIMBUS_DCHECK(done);
+  return done ? reduced : Rgb(1.0);
+}
 
 // One deposit sample at q (the midpoint of a step of length dl of the flight along w): the weight loses
 // exp(-sigma_loss dl) over the step and the midpoint's weight, divided by the straight-line model phi_0
@@ -164,7 +180,7 @@ void BeamPhotons::sample(float* tally, const Vec3& q, const Vec3& w, double dl, 
   }
   const Rgb mid = *weight * half;
   *weight = mid * half;
-  const Rgb tw = T_wide.lookup(q);
+  const Rgb tw = wide(q);
   const double geo = point ? 1.0 / std::max(1e-300, dot(q - point->position, q - point->position)) : 1.0;
   const bool traced = to != Columns::straight;
   // The cosine between the travel direction and the straight one from the light.
@@ -266,7 +282,7 @@ void BeamPhotons::trace(size_t j, Rng& rng, PhotonBatch& batch) const {
 bool BeamPhotons::scatter(const Vec3& xc, Vec3* w, BeamWalk& walk, Rng& rng, PhotonBatch& batch) const {
   const int c = walk.c;
   // Roulette on the ratio to the model (what is deposited), not on the weight alone.
-  const double tw = T_wide.lookup(xc)[c] * walk.w0;
+  const double tw = wide(xc)[c] * walk.w0;
   if (tw > 0.0 && walk.weight[c] < kRoulette * tw) {
     const double keep = walk.weight[c] / (kRoulette * tw);
     NIMBUS_DCHECK(keep >= 0.0 && keep < 1.0);
@@ -332,6 +348,7 @@ BeamGrid::BeamGrid(const SceneContext& ctx, const std::vector<const PhaseSplit*>
                            .splits = splits,
                            .peak_fraction = peak_fraction,
                            .T_wide = reduced_maps[l],
+                           .chord = reduced_maps[l].memory_bytes() == 0,
                            .grid = grid_,
                            .light = l,
                            .point = point,

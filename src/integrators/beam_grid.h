@@ -33,7 +33,8 @@ namespace nimbus {
 
 class BeamGrid {
  public:
-  // reduced_maps[l]: light l's T_wide; photons: per light; resolution as ScatterGridSettings.
+  // reduced_maps[l]: light l's T_wide (an empty map: the chord in closed form, for one constant-density
+  // sphere or box only); photons: per light; resolution as ScatterGridSettings.
   // skip_idle: no deposits in cells with no medium in them or next to them (the lookup is the same
   // wherever there is a medium; for tests: false deposits everywhere).
   BeamGrid(const SceneContext& ctx, const std::vector<const PhaseSplit*>& splits,

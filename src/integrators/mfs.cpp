@@ -215,11 +215,14 @@ void MfsIntegrator::build_maps() {
     const int res = is_area_light(l) ? 8 : s_.shadow_map_resolution;  // area lights: a token map (light_beam)
     if (*s_.exact_light_transmittance) {
       // light_beam reads the chord: only the beam grid's photons read a map (the reduced one; the
-      // same map as build_pair's).
+      // same map as build_pair's), and on one constant-density shape they read the chord too (an empty
+      // map: BeamGrid).
       full_maps_.emplace_back();
+      const bool chord = ctx_.analytic.active() && ctx_.media.count() == 1;
       if (s_.forward_light_path())
-        reduced_maps_.push_back(beam ? TransmittanceGrid(ctx_.media, ctx_.majorants, l, res, map_step, f_)
-                                     : TransmittanceGrid());
+        reduced_maps_.push_back(beam && !chord
+                                    ? TransmittanceGrid(ctx_.media, ctx_.majorants, l, res, map_step, f_)
+                                    : TransmittanceGrid());
     } else if (s_.forward_light_path()) {
       TransmittanceGrid::build_pair(ctx_.media, ctx_.majorants, l, res, map_step, f_,
                                     &full_maps_.emplace_back(), &reduced_maps_.emplace_back());
@@ -444,19 +447,7 @@ void MfsIntegrator::exact_light_transmittance(const Vec3& p, const LightSample& 
   // One constant-density sphere or box: the chord to the light in closed form. The shadow maps'
   // interpolation over-estimates T where the light grazes a sharp boundary (the chord grows like sqrt of
   // the distance to the tangent point): a backlit sphere's rim (less since the maps interpolate depth).
-  double t0 = 0.0, t1 = 0.0;
-  if (ctx_.analytic.active() && ctx_.media.count() == 1) {
-    if (!ctx_.analytic.chord(0, p, ls.wi, ls.distance, &t0, &t1) || !(t1 > t0)) {
-      *T_light = *T_wide = Rgb(1.0);
-      return;
-    }
-    MediumPoint m;
-    ctx_.media.eval(p + ls.wi * (0.5 * (t0 + t1)), &m);
-    const Rgb sigma_t = m.sigma_t(), sigma_red = sigma_t - m.sigma_s_i[0] * f_[0];
-    *T_light = exp(-sigma_t * (t1 - t0));
-    *T_wide = exp(-sigma_red * (t1 - t0));
-    return;
-  }
+  if (chord_full_and_reduced(ctx_, p, ls.wi, ls.distance, f_, T_light, T_wide)) return;
   marched_full_and_reduced(ctx_, p, ls.wi, ls.distance, kSurfaceShadowStep, f_, T_light, T_wide);
 }
 

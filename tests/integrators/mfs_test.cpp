@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstring>
 
+#include "integrators/area_light_view.h"
 #include "integrators/octave.h"
 #include "integrators/registry.h"
 #include "integrators/shadow_map.h"
@@ -641,6 +642,48 @@ TEST(Mfs, BeamGridSkipsIdleCellsWithoutChangingTheMedia) {
               gap_differs, gap);
   EXPECT_GT(inside, 300);
   EXPECT_GT(gap_differs, gap / 2);
+}
+
+// The closed-form transmittances on one constant-density shape (the beam grid's T_wide and `mfs`'s light
+// transmittance there) against a fine midpoint march of the same two extinctions, from points inside and
+// outside a sphere and a box, to infinity and to a point; and no closed form for two shapes.
+TEST(Mfs, ChordTransmittanceMatchesTheMarch) {
+  for (const std::string shape : {R"({"type": "sphere", "center": [0.1, 0, -0.2], "radius": 1})",
+                                  R"({"type": "box", "min": [-1, -0.7, -0.9], "max": [0.8, 1, 1]})"}) {
+    const Scene scene = test::scene_from_json("{" + test::camera_json(8, 8) + R"(,
+      "media": [{"shape": )" + shape + R"(, "sigma_s": [2.0, 1.5, 1.0], "sigma_a": 0.2,
+                 "phase": {"type": "hg", "g": 0.9}}],
+      "lights": [{"type": "directional", "direction": [0.3, 1, -0.2], "irradiance": 1.0}]})");
+    const SceneContext ctx(scene);
+    const std::vector<double> f{0.81};
+    Rng rng(9, 0);
+    int crossed = 0;
+    for (int i = 0; i < 200; ++i) {
+      const Vec3 p(3 * rng.uniform() - 1.5, 3 * rng.uniform() - 1.5, 3 * rng.uniform() - 1.5);
+      // Mostly towards the shape (i % 4 == 0: anywhere).
+      const Vec3 r(rng.uniform() - 0.5, rng.uniform() - 0.5, rng.uniform() - 0.5);
+      const Vec3 w = normalize(i % 4 ? r * 1.5 - p : r);
+      const double tmax = i % 2 ? 1e30 : 1.5 * rng.uniform();
+      Rgb full, reduced, full_m, reduced_m;
+      ASSERT_TRUE(chord_full_and_reduced(ctx, p, w, tmax, f, &full, &reduced));
+      marched_full_and_reduced(ctx, p, w, tmax, 1e-4, f, &full_m, &reduced_m);
+      for (int c = 0; c < 3; ++c) {
+        // The march's own error: its first and last steps straddle the boundary (1e-4 optical depth).
+        EXPECT_NEAR(full[c], full_m[c], 2e-4) << shape << " at " << p << " towards " << w;
+        EXPECT_NEAR(reduced[c], reduced_m[c], 2e-4) << shape << " at " << p << " towards " << w;
+      }
+      EXPECT_LE(full.x, reduced.x);
+      crossed += full.x < 0.99;
+    }
+    EXPECT_GT(crossed, 100) << shape;  // paths through the medium, not only misses
+  }
+  const Scene two = test::scene_from_json("{" + test::camera_json(8, 8) + R"(,
+    "media": [{"shape": {"type": "sphere", "center": [-1, 0, 0], "radius": 0.5}, "sigma_s": 1.0, "sigma_a": 0.1},
+              {"shape": {"type": "sphere", "center": [1, 0, 0], "radius": 0.5}, "sigma_s": 1.0, "sigma_a": 0.1}],
+    "lights": [{"type": "directional", "direction": [1, 0, 0], "irradiance": 1.0}]})");
+  const SceneContext ctx2(two);
+  Rgb full, reduced;
+  EXPECT_FALSE(chord_full_and_reduced(ctx2, Vec3(0.0), Vec3(1, 0, 0), 1e30, {0.5, 0.5}, &full, &reduced));
 }
 
 // Grey media under lights of grey strength keep one channel per column (the three would be the same
