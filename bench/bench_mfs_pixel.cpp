@@ -7,7 +7,8 @@
 //    percentile, maximum; from the per-thread step counter mfs_march_steps of integrators/mfs.h), ns per
 //    such ray;
 //  - BM_MfsPixelSkeleton: the same rays through the bare march (march_growing with the media's
-//    extinction and the camera-side state, no lights, no grids): the floor that the light estimators sit on.
+//    extinction and the camera-side state, no lights, no grids; over the pieces of constant-density
+//    shapes, as `mfs`): the floor that the light estimators sit on.
 // range(0) picks the scene (kScenes), range(1) the image width (height from the scene's aspect), range(2)
 // the threads. The integrator's options: the defaults, or those in $NIMBUS_BENCH_MFS (a JSON object). Results: docs/benchmarks.md, "Per-pixel cost of mfs and the 1080p cloud".
 #include <benchmark/benchmark.h>
@@ -173,15 +174,18 @@ void BM_MfsPixelSkeleton(benchmark::State& state) {
       MediumPoint mp;
       const double jitter = rng.uniform();
       uint32_t n = 0;
-      march_growing(
-          ctx.majorants, ray.o, ray.d, std::numeric_limits<double>::infinity(), s.tau_step, jitter,
-          [&](double, double) { return 1.0 + s.step_growth * max_component(cam.tau_red); },
-          [&](const Vec3& q, double t, double dt) {
-            ++n;
-            ctx.media.eval(q, &mp);
-            cam.advance(mfs_extinction(mp, f, theta2), t, dt, jitter);
-            return max_component(cam.T_red) > 1e-6;
-          });
+      const auto scale = [&](double, double) { return 1.0 + s.step_growth * max_component(cam.tau_red); };
+      const auto step = [&](const Vec3& q, double t, double dt) {
+        ++n;
+        ctx.media.eval(q, &mp);
+        cam.advance(mfs_extinction(mp, f, theta2), t, dt, jitter);
+        return max_component(cam.T_red) > 1e-6;
+      };
+      const double inf = std::numeric_limits<double>::infinity();
+      if (ctx.analytic.active())  // as MfsIntegrator::trace: over the pieces of constant-density shapes
+        march_growing(ctx.analytic, ray.o, ray.d, inf, s.tau_step, p.mfs->max_step(), jitter, scale, step);
+      else
+        march_growing(ctx.majorants, ray.o, ray.d, inf, s.tau_step, jitter, scale, step);
       benchmark::DoNotOptimize(cam.T_red);
       return n;
     });

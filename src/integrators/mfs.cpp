@@ -198,6 +198,13 @@ MfsIntegrator::MfsIntegrator(const SceneContext& context, MfsSettings settings, 
     grid.majorants = tracking;
     grid_ = std::make_unique<ScatterGrid>(ctx_, splits, f_, grid);
   }
+  // The pieces' march (constant-density shapes) steps at most one node spacing of the photon grids: the
+  // light they hold varies on that scale (the majorant grid's cells, of about the same size, bound the
+  // steps elsewhere). Without grids, 1/32 of the media's extent, as those cells.
+  const Vec3 extent = ctx_.media.bounds().hi - ctx_.media.bounds().lo;
+  max_step_ = std::max({extent.x, extent.y, extent.z}) / 32.0;
+  if (grid_) max_step_ = std::min(max_step_, grid_->node_grid().min_spacing());
+  if (beam_) max_step_ = std::min(max_step_, beam_->node_grid().min_spacing());
   if (grid_ && beam_) {
     const NodeGrid &a = grid_->node_grid(), &b = beam_->node_grid();
     shared_stencil_ = a.bounds.lo == b.bounds.lo && a.bounds.hi == b.bounds.hi && a.nodes == b.nodes &&
@@ -262,41 +269,43 @@ Rgb MfsIntegrator::trace(const Ray& ray, Rng& rng, CameraSample* sample, int bou
   MarchRecorder layers(sample);  // direct: the lights' light that took at most one wide scatter
   const ShBasis y_out(-d, grid_ ? grid_->bands() : 1);  // the scatter grid's basis towards the camera
   Rgb direct(0.0);
-  march_growing(
-      ctx_.majorants, o, d, hit.t, s_.tau_step, jitter,
-      // Steps of tau_step (1 + step_growth tau_red); fixed steps of at most kEmissionStep where a medium may
-      // emit (eq. D13: growing steps would sample the emission's variation, which no blur smooths, too coarsely).
-      [&](double t0, double t1) {
-        return ctx_.majorants.may_emit_at(o + d * (0.5 * (t0 + t1)))
-                   ? std::min(1.0, kEmissionStep / s_.tau_step)
-                   : 1.0 + s_.step_growth * max_component(cam.tau_red);
-      },
-      [&](const Vec3& p, double t, double dt) {
-        ++mfs_march_steps;
-        // Split the extinction at p into peak and reduced parts (eq. D2).
-        ctx_.media.eval(p, &mp);
-        const MfsExtinction k = mfs_extinction(mp, f_, theta2_);
-        Rgb L_step(0.0);
-        // Add what each medium scatters towards the camera at the sample point y = p.
-        if (max_component(mp.sigma_s) > 0.0) {
-          const CameraPoint y = cam.at(k, jitter, dt, s_.light_side(), s_.path_lengthening);
-          const Sources src = step_sources(mp, p, d, y_out, t, y, cam, rng, probe ? &*probe : nullptr);
-          L_step = (y.T_cam * src.in_scatter + y.T_full * src.peak_scatter) * dt;
-          L += L_step;
-          direct += (y.T_cam * src.lights_scatter + y.T_full * src.peak_scatter) * dt;
-        }
-        // Advance the camera-side state over the whole step.
-        const Rgb T0 = s_.light_side() ? cam.T_full : cam.T_red;
-        cam.advance(k, t, dt, jitter);
-        if (ctx_.media
-                .emits()) {  // emission along the ray, through the same transmittance as the grid's light
-          const Rgb E = emission_over_step(mp.emission, T0, s_.light_side() ? cam.T_full : cam.T_red, dt);
-          L += E;
-          L_step += E;
-        }
-        layers.step(t - jitter * dt, dt, T0, s_.light_side() ? cam.T_full : cam.T_red, mp, L_step);
-        return max_component(s_.light_side() ? cam.T_full : cam.T_red) > 1e-6;
-      });
+  // Steps of tau_step (1 + step_growth tau_red); fixed steps of at most kEmissionStep where a medium may
+  // emit (eq. D13: growing steps would sample the emission's variation, which no blur smooths, too coarsely).
+  const auto scale = [&](double t0, double t1) {
+    return ctx_.majorants.may_emit_at(o + d * (0.5 * (t0 + t1)))
+               ? std::min(1.0, kEmissionStep / s_.tau_step)
+               : 1.0 + s_.step_growth * max_component(cam.tau_red);
+  };
+  const auto step = [&](const Vec3& p, double t, double dt) {
+    ++mfs_march_steps;
+    // Split the extinction at p into peak and reduced parts (eq. D2).
+    ctx_.media.eval(p, &mp);
+    const MfsExtinction k = mfs_extinction(mp, f_, theta2_);
+    Rgb L_step(0.0);
+    // Add what each medium scatters towards the camera at the sample point y = p.
+    if (max_component(mp.sigma_s) > 0.0) {
+      const CameraPoint y = cam.at(k, jitter, dt, s_.light_side(), s_.path_lengthening);
+      const Sources src = step_sources(mp, p, d, y_out, t, y, cam, rng, probe ? &*probe : nullptr);
+      L_step = (y.T_cam * src.in_scatter + y.T_full * src.peak_scatter) * dt;
+      L += L_step;
+      direct += (y.T_cam * src.lights_scatter + y.T_full * src.peak_scatter) * dt;
+    }
+    // Advance the camera-side state over the whole step.
+    const Rgb T0 = s_.light_side() ? cam.T_full : cam.T_red;
+    cam.advance(k, t, dt, jitter);
+    if (ctx_.media.emits()) {  // emission along the ray, through the same transmittance as the grid's light
+      const Rgb E = emission_over_step(mp.emission, T0, s_.light_side() ? cam.T_full : cam.T_red, dt);
+      L += E;
+      L_step += E;
+    }
+    layers.step(t - jitter * dt, dt, T0, s_.light_side() ? cam.T_full : cam.T_red, mp, L_step);
+    return max_component(s_.light_side() ? cam.T_full : cam.T_red) > 1e-6;
+  };
+  // Constant-density shapes: steps over their pieces, by optical depth alone (tracking.h).
+  if (ctx_.analytic.active())
+    march_growing(ctx_.analytic, o, d, hit.t, s_.tau_step, max_step_, jitter, scale, step);
+  else
+    march_growing(ctx_.majorants, o, d, hit.t, s_.tau_step, jitter, scale, step);
   // Add the surface the ray ends on (lit directly and by one gathered ray) or the environment behind the
   // medium (its scattered light is in the grid). Camera side: light smooth in angle keeps its
   // peak-scattered part on the ray, so only the reduced extinction removes it.

@@ -131,6 +131,8 @@ class MfsIntegrator final : public Integrator {
   const PhaseSplit& split(int medium) const { return *splits_[medium]; }
   const ScatterGrid* scatter_grid() const { return grid_.get(); }
   const BeamGrid* beam_grid() const { return beam_.get(); }
+  // The longest step of the march over analytic pieces (constant-density shapes): the grids' node spacing.
+  double max_step() const { return max_step_; }
   // Bytes held by the deep shadow maps and the scatter grid.
   size_t memory_bytes() const;
 
@@ -143,6 +145,7 @@ class MfsIntegrator final : public Integrator {
   std::vector<TransmittanceGrid> full_maps_, reduced_maps_;  // per light
   std::unique_ptr<ScatterGrid> grid_;                        // wide scatters 2 .. K (null for K = 1)
   std::unique_ptr<BeamGrid> beam_;                           // the peak-only beams' correction (or null)
+  double max_step_ = 0.0;        // the longest march step over analytic pieces (the grids' node spacing)
   bool shared_stencil_ = false;  // both photon grids, on one node layout: one stencil per march point
 
   // The parts of `Li` (mfs.cpp); the physics is in mfs_estimators.h.

@@ -117,6 +117,29 @@ void march_growing(const MajorantGrid& grid, const Vec3& o, const Vec3& d, doubl
   });
 }
 
+// The same over the pieces of analytic media (media/analytic_media.h), which have no cells: each step of at
+// most tau_step * scale(t, t1) optical depth at the piece's extinction and at most max_step long, scale
+// asked at the start of every step (t1: the piece's end), the last step of a piece ending at it. The steps follow the optical depth
+// alone (a majorant grid's cells put at least one step in every cell crossed), and none falls outside
+// the media.
+template <typename Scale, typename F>
+void march_growing(const AnalyticMedia& media, const Vec3& o, const Vec3& d, double tmax, double tau_step,
+                   double max_step, double offset, Scale&& scale, F&& on_step) {
+  media.traverse(o, d, tmax, [&](double t0, double t1, double maj) {
+    double t = t0;
+    bool last = false;
+    while (!last) {
+      double dt = std::min(max_step, tau_step * scale(t, t1) / maj);
+      last = !(t + dt < t1);
+      if (last) dt = t1 - t;
+      const double ts = t + offset * dt;
+      if (!on_step(o + d * ts, ts, dt)) return false;
+      t += dt;
+    }
+    return true;
+  });
+}
+
 // Unbiased per-channel transmittance along o + t d, t in (0, tmax), by ratio tracking against the
 // extinction sigma(p) -> Rgb (at most the majorant), with Russian roulette once every channel has
 // fallen below 0.1.
