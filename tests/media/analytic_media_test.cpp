@@ -5,7 +5,9 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
+#include <vector>
 
 #include "integrators/tracking.h"
 #include "support/scenes.h"
@@ -135,6 +137,58 @@ TEST(Tracking, AnalyticFreeFlightsMatchBeerLambert) {
   EXPECT_NEAR(double(escaped) / n, T, 5.0 * sigma);
   EXPECT_GT(T, 0.1);
   EXPECT_LT(T, 0.9);
+}
+
+// The growing march over the pieces (integrators/tracking.h, `mfs`'s march on constant-density shapes):
+// the steps tile each piece exactly, none is longer than max_step or deeper than tau_step x scale at the
+// piece's extinction, each sample sits at `offset` of its step inside its piece, the optical depth sums to
+// -log T, and a step that returns false ends the march.
+TEST(Tracking, AnalyticMarchTilesThePiecesByOpticalDepth) {
+  const SceneMedia media = media_of(R"([
+    {"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1}, "sigma_s": 2.0,
+     "transform": {"scale": [1.5, 0.8, 1.2]}},
+    {"shape": {"type": "box", "min": [-0.5, -2, -0.3], "max": [0.7, 2, 0.4]}, "sigma_s": 0.7, "sigma_a": 0.3},
+    {"shape": {"type": "sphere", "center": [2, 0, 0], "radius": 0.3}, "sigma_s": 5.0}])");
+  const AnalyticMedia a(media);
+  const Vec3 o(-3, 0.05, 0.1), d = normalize(Vec3(1, 0.02, -0.01));
+  const double tau_step = 0.2, max_step = 0.05, offset = 0.3;
+  std::vector<std::array<double, 3>> pieces;  // t0, t1, majorant
+  a.traverse(o, d, 10.0, [&](double t0, double t1, double maj) {
+    return pieces.push_back({t0, t1, maj}), true;
+  });
+  ASSERT_EQ(pieces.size(), 4u);
+  double depth = 0.0, growth = 0.0, end = 0.0;
+  size_t piece = 0;
+  int steps = 0;
+  march_growing(
+      a, o, d, 10.0, tau_step, max_step, offset, [&](double, double) { return 1.0 + growth; },
+      [&](const Vec3& p, double t, double dt) {
+        const double t_start = t - offset * dt;
+        while (piece < pieces.size() && t_start >= pieces[piece][1] - 1e-12) ++piece;
+        EXPECT_LT(piece, pieces.size());
+        if (piece >= pieces.size()) return false;
+        const auto& [t0, t1, maj] = pieces[piece];
+        // Contiguous within the piece: each step starts where the last ended (or at the piece's start).
+        EXPECT_NEAR(t_start, end > t0 ? end : t0, 1e-12);
+        EXPECT_LE(t_start + dt, t1 + 1e-12);
+        EXPECT_LE(dt, max_step * (1 + 1e-12));
+        EXPECT_LE(dt * maj, tau_step * (1.0 + growth) * (1 + 1e-12));
+        EXPECT_NEAR((p - o).length(), t, 1e-12);
+        depth += dt * maj;
+        end = t_start + dt;
+        if (std::abs(end - t1) < 1e-12) end = t1;
+        growth += 0.5;  // later steps may be deeper
+        ++steps;
+        return true;
+      });
+  EXPECT_NEAR(end, pieces.back()[1], 1e-12);
+  EXPECT_NEAR(depth, -std::log(a.transmittance(o, d, 10.0)[0]), 1e-9);
+  EXPECT_GT(steps, 20);
+  int taken = 0;
+  march_growing(
+      a, o, d, 10.0, tau_step, max_step, offset, [](double, double) { return 1.0; },
+      [&](const Vec3&, double, double) { return ++taken < 3; });
+  EXPECT_EQ(taken, 3);
 }
 
 }  // namespace
