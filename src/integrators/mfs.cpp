@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <limits>
 #include <optional>
 
 #include "core/json_reader.h"
@@ -201,10 +203,13 @@ MfsIntegrator::MfsIntegrator(const SceneContext& context, MfsSettings settings, 
   // The pieces' march (constant-density shapes) steps at most one node spacing of the photon grids: the
   // light they hold varies on that scale (the majorant grid's cells, of about the same size, bound the
   // steps elsewhere). Without grids, 1/32 of the media's extent, as those cells.
+  // (The spacing along the grids' longest axis: a flat box's thin axis has a spacing of its own thickness.)
+  const auto spacing = [](const NodeGrid& g) { return std::max({g.spacing.x, g.spacing.y, g.spacing.z}); };
   const Vec3 extent = ctx_.media.bounds().hi - ctx_.media.bounds().lo;
   max_step_ = std::max({extent.x, extent.y, extent.z}) / 32.0;
-  if (grid_) max_step_ = std::min(max_step_, grid_->node_grid().min_spacing());
-  if (beam_) max_step_ = std::min(max_step_, beam_->node_grid().min_spacing());
+  if (grid_) max_step_ = std::min(max_step_, spacing(grid_->node_grid()));
+  if (beam_) max_step_ = std::min(max_step_, spacing(beam_->node_grid()));
+  if (!(max_step_ > 0.0)) max_step_ = std::numeric_limits<double>::infinity();  // no media (no pieces)
   if (grid_ && beam_) {
     const NodeGrid &a = grid_->node_grid(), &b = beam_->node_grid();
     shared_stencil_ = a.bounds.lo == b.bounds.lo && a.bounds.hi == b.bounds.hi && a.nodes == b.nodes &&
