@@ -58,7 +58,7 @@ TEST(ScatterGrid, PowerShareKeepsTheMean) {
   double mean[2] = {}, var[2] = {};
   for (int k = 0; k < 2; ++k) {
     double v[kSeeds];
-    for (int i = 0; i < kSeeds; ++i) v[i] = grid_sum(ctx, k == 0 ? 0.0 : 1.0, uint64_t(i + 1), 2048);
+    for (int i = 0; i < kSeeds; ++i) v[i] = grid_sum(ctx, k == 0 ? 0.0 : 1.0, uint64_t(i + 1), 4096);
     for (double x : v) mean[k] += x / kSeeds;
     for (double x : v) var[k] += (x - mean[k]) * (x - mean[k]) / (kSeeds - 1);
   }
@@ -67,7 +67,8 @@ TEST(ScatterGrid, PowerShareKeepsTheMean) {
               std::sqrt(var[1] / kSeeds));
   ASSERT_GT(mean[0], 0.0);
   // The sun's photons carrying its power / (the even count) instead of / (its power share's count) would
-  // put the sun's part of the grid ~80 % high (0.89 / 0.5), the sky's ~80 % low.
+  // put the sun's part of the grid ~80 % high (0.89 / 0.5), the sky's ~80 % low. (4096 photons per grid:
+  // with 2048, clang's streams gave se = 5.03 % of the mean once the photons flew over the sphere's piece.)
   EXPECT_LT(se, 0.05 * mean[0]);
   EXPECT_NEAR(mean[1], mean[0], 4.0 * se);
   EXPECT_NE(grid_sum(ctx, 0.0, 1, 4096), grid_sum(ctx, 1.0, 1, 4096));
