@@ -147,11 +147,31 @@ int auto_scatter_grid_resolution(const SceneContext& ctx) {
 // N = sqrt(a F / (b^2 c)), so the count follows the square root of the pixels. Measured at 512 x 512
 // (docs/benchmarks.md, "Photons by image size"): 4 x 2^18 gives 0.70x error^2 x CPU on the Disney cloud and 0.56x on the
 // front-lit r = 10 sphere against 2^18. The full image's pixels, not the spp or a region's: a resumed,
-// cropped or sample-range render traces the same photons as the render in one go.
+// cropped or sample-range render traces the same photons as the render in one go. The scatter grid then
+// scales this by its pilot's collisions per photon (ScatterGridSettings::adaptive_photons).
 int auto_photons(const PinholeCamera& camera) {
   const double pixels = double(camera.width()) * double(camera.height());
   const double n = double(1 << 18) * std::sqrt(std::max(1.0, pixels / (128.0 * 128.0)));
   return int(std::min(std::round(n), double(1 << 26)));
+}
+
+// The scatter grid's settings from mfs's (photons resolved; adaptive: they were "auto").
+ScatterGridSettings scatter_grid_settings(const MfsSettings& s, bool adaptive, uint64_t seed,
+                                          const MajorantGrid* tracking) {
+  ScatterGridSettings grid;
+  grid.photons = *s.photons;
+  grid.adaptive_photons = adaptive;
+  grid.resolution = *s.scatter_grid_resolution;
+  grid.max_wide_scatters = s.large_angle_scatters.value_or(0);
+  grid.exact_transport = s.photon_transport == PhotonTransport::exact;
+  grid.channel_passes = s.channel_passes;
+  grid.bands = s.scatter_grid_bands;
+  grid.live_nodes_only = !s.filtered_lookups;  // the pre-filtered levels read every node
+  grid.prefiltered = s.filtered_lookups;       // only filtered lookups read them
+  grid.splat = s.photon_splat;
+  grid.seed = seed;
+  grid.majorants = tracking;
+  return grid;
 }
 
 }  // namespace
@@ -186,19 +206,9 @@ MfsIntegrator::MfsIntegrator(const SceneContext& context, MfsSettings settings, 
   // Wide scatters 2 .. K from the scatter grid (for K = 1 only the environment's light).
   if (s_.large_angle_scatters != 0 &&
       (s_.large_angle_scatters != 1 || ctx_.has_environment || ctx_.media.emits())) {
-    ScatterGridSettings grid;
-    grid.photons = *s_.photons;
-    grid.resolution = *s_.scatter_grid_resolution;
-    grid.max_wide_scatters = s_.large_angle_scatters.value_or(0);
-    grid.exact_transport = s_.photon_transport == PhotonTransport::exact;
-    grid.channel_passes = s_.channel_passes;
-    grid.bands = s_.scatter_grid_bands;
-    grid.live_nodes_only = !s_.filtered_lookups;  // the pre-filtered levels read every node
-    grid.prefiltered = s_.filtered_lookups;       // only filtered lookups read them
-    grid.splat = s_.photon_splat;
-    grid.seed = seed;
-    grid.majorants = tracking;
-    grid_ = std::make_unique<ScatterGrid>(ctx_, splits, f_, grid);
+    grid_ = std::make_unique<ScatterGrid>(ctx_, splits, f_,
+                                          scatter_grid_settings(s_, !settings.photons, seed, tracking));
+    s_.photons = grid_->photons();
   }
   // The pieces' march (constant-density shapes) steps at most one node spacing of the photon grids: the
   // light they hold varies on that scale (the majorant grid's cells, of about the same size, bound the

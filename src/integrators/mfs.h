@@ -37,7 +37,7 @@
 // | `propagator`              | "gsa" or "gaussian"           | "gsa"     | the peak's own moments in the small-angle propagator, or a Gaussian stand-in with the same theta2 |
 // | `peak_fraction`           | "auto" or [0, 0.99]           | "auto"    | f, the part of each phase function carried as a forward peak ("auto": g^2 per medium) |
 // | `large_angle_scatters`    | "all" or integer in [0, 1024] | "all"     | K, at most K wide scatters per path (0: the peak only; 1: the seed's picture) |
-// | `photons`                 | "auto" or integer in [1, 2^26] | "auto"   | scatter grid photons per pass, shared among the lights (80 % by power, 20 % evenly) ("auto": 2^18 up to 128 x 128 pixels, then 2^18 sqrt(pixels / 128^2); the header of a rendered image holds the number chosen) |
+// | `photons`                 | "auto" or integer in [1, 2^26] | "auto"   | scatter grid photons per pass, shared among the lights (80 % by power, 20 % evenly) ("auto": 2^18 up to 128 x 128 pixels, then 2^18 sqrt(pixels / 128^2), times clamp(sqrt(3.4 / C), 1, 4) for C real collisions per photon of a pilot (ScatterGridSettings::adaptive_photons); the header of a rendered image holds the number chosen) |
 // | `photon_transport`        | "exact" or "similarity"       | "exact"   | scatter grid photons in the true medium, or in the delta-scaled one |
 // | `channel_passes`          | boolean                       | false     | chromatic media: one scatter grid photon pass per colour channel (each with its own coefficients) instead of one pass of hero-channel photons carrying all three (scatter_grid.h) |
 // | `scatter_grid_resolution` | "auto" or integer in [4, 96]  | "auto"    | scatter and beam grid nodes along the longest axis ("auto": ~1.6 optical depths per cell, 32 to 64; the header of a rendered image holds the number chosen) |
@@ -89,7 +89,7 @@ struct MfsSettings {
   Propagator propagator = Propagator::gsa;
   std::optional<double> peak_fraction;      // nullopt: "auto"
   std::optional<int> large_angle_scatters;  // nullopt: "all"
-  std::optional<int> photons;               // nullopt: "auto" (resolved by MfsIntegrator from the image size)
+  std::optional<int> photons;               // nullopt: "auto" (resolved by MfsIntegrator: image size, pilot)
   PhotonTransport photon_transport = PhotonTransport::exact;
   bool channel_passes = false;
   std::optional<int> scatter_grid_resolution;  // nullopt: "auto" (resolved by MfsIntegrator)

@@ -280,6 +280,7 @@ struct ScatterPhotons {
   double majorant_scale;            // the share of the majorant that bounds the extinction the photons see
   std::vector<SourceBlock> blocks;  // per source, as trace numbers them
 
+  void split(int photons);  // first = photon_split(..., photons, ...)
   void trace(size_t j, Rng& rng, PhotonBatch& batch) const;
   bool reflect(const SurfaceHit& hit, Vec3* w, int c, double* weight, int* order, Rng& rng) const;
   bool scatter(const Vec3& xc, Vec3* w, int c, double* weight, int* order, Rng& rng,
@@ -491,13 +492,13 @@ bool ScatterPhotons::scatter_hero(const Vec3& xc, Vec3* w, HeroWalk& walk, int* 
 
 // The photons of each source (numbered as ScatterPhotons::trace numbers them) as first[i] ..
 // first[i + 1] - 1 of a pass: a share s.power_share p_i / sum p + (1 - s.power_share) / sources of
-// s.photons (at least 1), p_i the luminance of source i's power towards the media's bounding sphere
+// `photons` (at least 1), p_i the luminance of source i's power towards the media's bounding sphere
 // (the mean of 64 of its photons' power, each emitted as the only one; exact for a directional light
 // or a constant environment). power_share 1 gives every photon the same power (photon mapping's rule);
 // the even part keeps a source of little power from being starved. Which photon belongs to which
 // source changes the grid's noise, never its expectation (each source's photons carry its power / n_i).
 std::vector<size_t> photon_split(const SceneContext& ctx, const EmissionSampler* emission,
-                                 const ScatterGridSettings& s, size_t lights, size_t sources,
+                                 const ScatterGridSettings& s, int photons, size_t lights, size_t sources,
                                  const Vec3& centre, double radius) {
   constexpr int kProbes = 64;
   std::vector<double> power(sources, 0.0);
@@ -518,7 +519,7 @@ std::vector<size_t> photon_split(const SceneContext& ctx, const EmissionSampler*
   std::vector<size_t> first(sources + 1, 0);
   for (size_t i = 0; i < sources; ++i) {
     const double share = (sum > 0.0 ? mix * power[i] / sum : 0.0) + (1.0 - mix) / double(sources);
-    first[i + 1] = first[i] + std::max<size_t>(1, size_t(std::llround(share * double(s.photons))));
+    first[i + 1] = first[i] + std::max<size_t>(1, size_t(std::llround(share * double(photons))));
   }
   return first;
 }
@@ -554,11 +555,43 @@ std::vector<uint8_t> live_nodes(const NodeGrid& grid, const MajorantGrid& majora
   return live;
 }
 
+// adaptive_photons (scatter_grid.h): the pilot's photons, and the collisions per photon at which the
+// grid keeps settings.photons. On the validation suite (128 x 128, `mfs` 1 spp) error^2 x CPU is least
+// at about 2^18 photons on the optically thick spheres, the box and the Disney cloud (3.4 to 4.4
+// collisions per photon), 2^19 on the r = 2 sphere (0.89) and 2^20 on the r = 1 sphere (0.44)
+// (docs/benchmarks.md, "Photons by collisions").
+constexpr int kPilotPhotons = 2048;
+constexpr double kDenseCollisions = 3.4;
+
+void ScatterPhotons::split(int photons) {
+  first = photon_split(ctx, emission, s, photons, lights, sources, centre, radius);
+}
+
+// Real collisions per photon of kPilotPhotons photons of a pass (photons.first is left split for them),
+// traced serially on streams of their own into a tally that is dropped.
+double pilot_collisions(ScatterPhotons& photons, size_t tally_size) {
+  photons.split(kPilotPhotons);
+  ZeroedFloats tally(tally_size);
+  PhotonBatch batch;
+  batch.tally = {tally.data(), tally_size};
+  const size_t n = photons.first.back();
+  for (size_t j = 0; j < n; ++j) {
+    Rng rng(photons.s.seed ^ 0x70696c6f74ull, j);
+    photons.trace(j, rng, batch);
+  }
+  return batch.collisions / double(n);
+}
+
+int adaptive_photon_count(int photons, double collisions) {
+  const double factor = std::clamp(std::sqrt(kDenseCollisions / std::max(collisions, 1e-3)), 1.0, 4.0);
+  return int(std::min(std::round(double(photons) * factor), double(1 << 26)));
+}
+
 }  // namespace
 
 ScatterGrid::ScatterGrid(const SceneContext& ctx, const std::vector<const PhaseSplit*>& splits,
                          const std::vector<double>& peak_fraction, const ScatterGridSettings& s)
-    : bands_(std::clamp(s.bands, 1, kShMaxBands)), coeffs_(bands_ * bands_) {
+    : bands_(std::clamp(s.bands, 1, kShMaxBands)), coeffs_(bands_ * bands_), photons_(s.photons) {
   const Bounds media_bounds = ctx.media.bounds();
   if (media_bounds.empty()) {
     values_.assign(grid_.size() * 3 * coeffs_, 0.0f);  // the default grid: 2^3 nodes over [0, 1]^3
@@ -612,18 +645,18 @@ void ScatterGrid::trace(const SceneContext& ctx, const std::vector<const PhaseSp
       .majorant_scale =
           s.exact_transport ? 1.0 : majorant_share(ctx.media, [&](int i) { return 1.0 - peak_fraction[i]; }),
       .blocks = {}};
-  photons.first = photon_split(ctx, photons.emission, s, lights, sources, photons.centre, photons.radius);
-  const size_t total = size_t(passes) * photons.first.back();
-  const size_t nodes = grid_.size();
   const std::vector<uint8_t> live = s.live_nodes_only
                                         ? live_nodes(grid_, s.majorants ? *s.majorants : ctx.majorants)
                                         : std::vector<uint8_t>();
   photons.live = live.empty() ? nullptr : live.data();
   size_t rgb_size = 0;
   const size_t tally_size =
-      assign_blocks(ctx, grey, lights, sources, nodes, coeffs_, &photons.blocks, &rgb_size);
+      assign_blocks(ctx, grey, lights, sources, grid_.size(), coeffs_, &photons.blocks, &rgb_size);
+  if (s.adaptive_photons) photons_ = adaptive_photon_count(s.photons, pilot_collisions(photons, tally_size));
+  photons.split(photons_);
+  const size_t total = size_t(passes) * photons.first.back();
   TallyFold fold;
-  fold.nodes = nodes;
+  fold.nodes = grid_.size();
   fold.out_floats = 3 * coeffs_;
   fold.fold = [&](const float* tally, size_t n, double wt, double* acc) {
     fold_node(photons.blocks, rgb_size, coeffs_, tally, n, wt, acc);

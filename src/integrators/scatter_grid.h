@@ -51,6 +51,12 @@ namespace nimbus {
 
 struct ScatterGridSettings {
   int photons = 1 << 18;  // per pass, shared among the lights (see power_share)
+  // More photons where they are cheap: a pilot of kPilotPhotons (scatter_grid.cpp) counts the photons'
+  // real collisions per photon C, and the grid traces photons x clamp(sqrt(kDenseCollisions / C), 1, 4).
+  // A photon's cost grows with C while the grid's noise per photon shrinks with it (more deposits), so
+  // thin media buy their error with more photons for less (docs/benchmarks.md, "Photons by collisions").
+  // `mfs`'s "auto" photons; off for a count given.
+  bool adaptive_photons = false;
   // Chromatic media: one photon pass per channel, each with that channel's coefficients (true), or one
   // pass of hero-channel photons carrying all three (false; scatter_grid.cpp's HeroWalk). Grey media
   // take one pass either way.
@@ -109,6 +115,8 @@ class ScatterGrid {
   // Similarity transport only: wide scatters whose direction the rejection sampler could not draw (the
   // photon flew on undeflected; see sample_by_rejection). 0 in every normal case.
   uint64_t rejection_failures() const { return rejection_failures_; }
+  // The photons traced per pass (settings.photons, or what adaptive_photons made of it).
+  int photons() const { return photons_; }
 
   size_t memory_bytes() const {
     size_t bytes = values_.size() * sizeof(float);
@@ -119,6 +127,7 @@ class ScatterGrid {
  private:
   NodeGrid grid_;  // the media's bounds padded by one spacing (node_grid_padded)
   int bands_ = 3, coeffs_ = 9;
+  int photons_ = 0;
   uint64_t rejection_failures_ = 0;
   FloatArray values_;  // per node: channel c at [coeffs c + h]: L_lm, h = l^2 + l + m
   struct Level {

@@ -17,9 +17,11 @@ std::string meta(const RenderResult& r, const std::string& key) {
   return "";
 }
 
-Scene settings_sphere_scene(const std::string& integrator, int width = 8, int height = 6) {
+Scene settings_sphere_scene(const std::string& integrator, int width = 8, int height = 6,
+                            double sigma_s = 3.0) {
   return test::scene_from_json("{" + test::camera_json(width, height) + R"(,
-    "media": [{"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1}, "sigma_s": 3.0, "sigma_a": 0.1,
+    "media": [{"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1}, "sigma_s": )" +
+                               std::to_string(sigma_s) + R"(, "sigma_a": 0.1,
                "phase": {"type": "hg", "g": 0.8}}],
     "lights": [{"type": "directional", "direction": [-1, 0.3, 0.2], "irradiance": 1.0},
                {"type": "environment", "radiance": 0.2}],
@@ -48,17 +50,33 @@ TEST(RenderSettings, AutoChoicesAreResolvedInTheHeader) {
   EXPECT_EQ(r2.settings, r.settings);
 }
 
-// "auto" photons: 2^18 up to 128 x 128 pixels, then 2^18 sqrt(pixels / 128^2), from the whole image's pixels:
-// a crop of a 256 x 256 image traces 2^19, as the whole image would.
+// "auto" photons: 2^18 up to 128 x 128 pixels, then 2^18 sqrt(pixels / 128^2), from the whole image's pixels,
+// times the factor of the medium's collisions per photon (the same pilot at every image size): a crop of
+// a 256 x 256 image traces twice the photons of an 8 x 6 image, as the whole 256 x 256 image would.
 TEST(RenderSettings, AutoPhotonsFollowTheWholeImagesPixels) {
   const std::string mfs = R"({"type": "mfs", "spp": 1, "beam_photons": 1024, "scatter_grid_resolution": 8})";
-  EXPECT_EQ(render(settings_sphere_scene(mfs)).settings["photons"], 1 << 18);
+  const int small = render(settings_sphere_scene(mfs)).settings["photons"];
+  EXPECT_GE(small, 1 << 18);
+  EXPECT_LE(small, 1 << 20);
   RenderOptions o;
   o.region = Region{100, 100, 102, 101};
   const RenderResult crop = render(settings_sphere_scene(mfs, 256, 256), o);
-  EXPECT_EQ(crop.settings["photons"], 1 << 19);
-  EXPECT_EQ(render(settings_sphere_scene(R"({"type": "mfs", "photons": "auto"})", 4, 4)).settings["photons"],
-            1 << 18);
+  EXPECT_NEAR(crop.settings["photons"].get<int>(), 2 * small, 1);
+}
+
+// "auto" photons by the pilot's collisions per photon: an optically thick sphere (radius 10 optical
+// depths, albedo 0.99; ~4 collisions per photon) keeps 2^18, a thin one (0.4 optical depths) takes more,
+// at most 4 x 2^18; a count given is kept.
+TEST(RenderSettings, AutoPhotonsFollowTheMediumsCollisions) {
+  const std::string mfs = R"({"type": "mfs", "spp": 1, "beam_photons": 1024, "scatter_grid_resolution": 8})";
+  EXPECT_EQ(render(settings_sphere_scene(mfs, 4, 3, 9.9)).settings["photons"], 1 << 18);
+  const int thin = render(settings_sphere_scene(mfs, 4, 3, 0.3)).settings["photons"];
+  const int mid = render(settings_sphere_scene(mfs, 4, 3, 3.0)).settings["photons"];
+  EXPECT_GT(thin, mid);
+  EXPECT_GT(mid, 1 << 18);
+  EXPECT_LE(thin, 1 << 20);
+  const std::string given = R"({"type": "mfs", "spp": 1, "photons": 5000, "beam_photons": 1024})";
+  EXPECT_EQ(render(settings_sphere_scene(given, 4, 3, 0.3)).settings["photons"], 5000);
 }
 
 // "auto" exact_light_transmittance: the closed-form chord for one constant-density sphere or box (the
