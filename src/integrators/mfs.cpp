@@ -148,10 +148,12 @@ int auto_scatter_grid_resolution(const SceneContext& ctx) {
 // (docs/benchmarks.md, "Photons by image size"): 4 x 2^18 gives 0.70x error^2 x CPU on the Disney cloud and 0.56x on the
 // front-lit r = 10 sphere against 2^18. The full image's pixels, not the spp or a region's: a resumed,
 // cropped or sample-range render traces the same photons as the render in one go. The scatter grid then
-// scales this by its pilot's collisions per photon (ScatterGridSettings::adaptive_photons).
+// raises this to 2^18 times a factor of its pilot's collisions per photon where that is more
+// (ScatterGridSettings::adaptive_photons).
+constexpr int kAutoPhotons = 1 << 18;
 int auto_photons(const PinholeCamera& camera) {
   const double pixels = double(camera.width()) * double(camera.height());
-  const double n = double(1 << 18) * std::sqrt(std::max(1.0, pixels / (128.0 * 128.0)));
+  const double n = double(kAutoPhotons) * std::sqrt(std::max(1.0, pixels / (128.0 * 128.0)));
   return int(std::min(std::round(n), double(1 << 26)));
 }
 
@@ -160,7 +162,7 @@ ScatterGridSettings scatter_grid_settings(const MfsSettings& s, bool adaptive, u
                                           const MajorantGrid* tracking) {
   ScatterGridSettings grid;
   grid.photons = *s.photons;
-  grid.adaptive_photons = adaptive;
+  grid.adaptive_photons = adaptive ? kAutoPhotons : 0;
   grid.resolution = *s.scatter_grid_resolution;
   grid.max_wide_scatters = s.large_angle_scatters.value_or(0);
   grid.exact_transport = s.photon_transport == PhotonTransport::exact;

@@ -582,9 +582,10 @@ double pilot_collisions(ScatterPhotons& photons, size_t tally_size) {
   return batch.collisions / double(n);
 }
 
-int adaptive_photon_count(int photons, double collisions) {
+// max(s.photons, s.adaptive_photons x clamp(sqrt(kDenseCollisions / collisions), 1, 4)).
+int adaptive_photon_count(const ScatterGridSettings& s, double collisions) {
   const double factor = std::clamp(std::sqrt(kDenseCollisions / std::max(collisions, 1e-3)), 1.0, 4.0);
-  return int(std::min(std::round(double(photons) * factor), double(1 << 26)));
+  return std::max(s.photons, int(std::min(std::round(double(s.adaptive_photons) * factor), double(1 << 26))));
 }
 
 }  // namespace
@@ -652,7 +653,7 @@ void ScatterGrid::trace(const SceneContext& ctx, const std::vector<const PhaseSp
   size_t rgb_size = 0;
   const size_t tally_size =
       assign_blocks(ctx, grey, lights, sources, grid_.size(), coeffs_, &photons.blocks, &rgb_size);
-  if (s.adaptive_photons) photons_ = adaptive_photon_count(s.photons, pilot_collisions(photons, tally_size));
+  if (s.adaptive_photons > 0) photons_ = adaptive_photon_count(s, pilot_collisions(photons, tally_size));
   photons.split(photons_);
   const size_t total = size_t(passes) * photons.first.back();
   TallyFold fold;

@@ -51,12 +51,13 @@ namespace nimbus {
 
 struct ScatterGridSettings {
   int photons = 1 << 18;  // per pass, shared among the lights (see power_share)
-  // More photons where they are cheap: a pilot of kPilotPhotons (scatter_grid.cpp) counts the photons'
-  // real collisions per photon C, and the grid traces photons x clamp(sqrt(kDenseCollisions / C), 1, 4).
-  // A photon's cost grows with C while the grid's noise per photon shrinks with it (more deposits), so
-  // thin media buy their error with more photons for less (docs/benchmarks.md, "Photons by collisions").
-  // `mfs`'s "auto" photons; off for a count given.
-  bool adaptive_photons = false;
+  // More photons where they are cheap: when > 0, a pilot of kPilotPhotons (scatter_grid.cpp) counts the
+  // photons' real collisions per photon C, and the grid traces
+  // max(photons, adaptive_photons x clamp(sqrt(kDenseCollisions / C), 1, 4)). A photon's cost grows with C
+  // while on thin media the grid's noise is most of the error, so thin media buy their error with more
+  // photons (docs/benchmarks.md, "Photons by collisions"). `mfs`'s "auto" photons: 2^18, its count at
+  // 128 x 128 (the larger images' counts already buy that noise down); 0 for a count given.
+  int adaptive_photons = 0;
   // Chromatic media: one photon pass per channel, each with that channel's coefficients (true), or one
   // pass of hero-channel photons carrying all three (false; scatter_grid.cpp's HeroWalk). Grey media
   // take one pass either way.
