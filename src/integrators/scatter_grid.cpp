@@ -562,6 +562,12 @@ std::vector<uint8_t> live_nodes(const NodeGrid& grid, const MajorantGrid& majora
 // (docs/benchmarks.md, "Photons by collisions").
 constexpr int kPilotPhotons = 2048;
 constexpr double kDenseCollisions = 3.4;
+constexpr double kMaxPhotonFactor = 4.0;
+
+// Whether a pilot could change the count: not where settings.photons is already the most it could give.
+bool wants_pilot(const ScatterGridSettings& s) {
+  return s.adaptive_photons > 0 && double(s.photons) < kMaxPhotonFactor * double(s.adaptive_photons);
+}
 
 void ScatterPhotons::split(int photons) {
   first = photon_split(ctx, emission, s, photons, lights, sources, centre, radius);
@@ -582,9 +588,10 @@ double pilot_collisions(ScatterPhotons& photons, size_t tally_size) {
   return batch.collisions / double(n);
 }
 
-// max(s.photons, s.adaptive_photons x clamp(sqrt(kDenseCollisions / collisions), 1, 4)).
+// max(s.photons, s.adaptive_photons x clamp(sqrt(kDenseCollisions / collisions), 1, kMaxPhotonFactor)).
 int adaptive_photon_count(const ScatterGridSettings& s, double collisions) {
-  const double factor = std::clamp(std::sqrt(kDenseCollisions / std::max(collisions, 1e-3)), 1.0, 4.0);
+  const double factor =
+      std::clamp(std::sqrt(kDenseCollisions / std::max(collisions, 1e-3)), 1.0, kMaxPhotonFactor);
   return std::max(s.photons, int(std::min(std::round(double(s.adaptive_photons) * factor), double(1 << 26))));
 }
 
@@ -653,7 +660,7 @@ void ScatterGrid::trace(const SceneContext& ctx, const std::vector<const PhaseSp
   size_t rgb_size = 0;
   const size_t tally_size =
       assign_blocks(ctx, grey, lights, sources, grid_.size(), coeffs_, &photons.blocks, &rgb_size);
-  if (s.adaptive_photons > 0) photons_ = adaptive_photon_count(s, pilot_collisions(photons, tally_size));
+  if (wants_pilot(s)) photons_ = adaptive_photon_count(s, pilot_collisions(photons, tally_size));
   photons.split(photons_);
   const size_t total = size_t(passes) * photons.first.back();
   TallyFold fold;
