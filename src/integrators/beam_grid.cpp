@@ -15,9 +15,9 @@ namespace nimbus {
 namespace {
 
 // Per node, in blocks of `channels` floats (3: rgb; 1: grey media under lights of grey strength, whose
-// three channels would be the same numbers): traced, traced x mean cosine, straight, and with a camera
-// (peak_toward) traced x P_peak towards the camera.
-constexpr int kBaseBlocks = 3, kCameraBlocks = 4;
+// three channels would be the same numbers): traced, traced x (1 - cosine), straight, straight x the
+// straight model's 1 - mean cosine, and with a camera (peak_toward) traced x P_peak towards the camera.
+constexpr int kBaseBlocks = 4, kCameraBlocks = 5;
 constexpr double kR2a1 = 0.75487766624669276, kR2a2 = 0.56984029099805327;  // the R2 sequence
 constexpr double kRoulette = 0.05;  // roulette below this ratio of weight to T_wide
 // Deposit samples (and the loss's midpoint rule) at most this many node spacings apart: 1 (0.5 before,
@@ -27,24 +27,39 @@ constexpr double kRoulette = 0.05;  // roulette below this ratio of weight to T_
 // the r2 sphere and the backlit spheres by +1.1 to +2.4 % (its loss no longer matches the traced one's).
 constexpr double kDepositStep = 1.0;
 
+// The straight model's mean cosine of the peak-only light, exp(-tau (1 - chi_1)) for its peak depth tau =
+// ln(T_wide / T_light) (eq. D3 at l = 1; peak_only_beam's tau_ps): (T_light / T_wide)^(1 - chi_1) per
+// channel, 0 where T_wide is 0. Grey transmittances: one pow.
+Rgb straight_mean_cosine(const Rgb& full, const Rgb& reduced, double one_minus_chi1) {
+  const auto one = [&](int c) {
+    return reduced[c] > 1e-30 ? std::pow(std::clamp(full[c] / reduced[c], 0.0, 1.0), one_minus_chi1) : 0.0;
+  };
+  if (full.x == full.y && full.y == full.z && reduced.x == reduced.y && reduced.y == reduced.z)
+    return Rgb(one(0));
+  return Rgb(one(0), one(1), one(2));
+}
+
 // Which columns a deposit sample goes to.
 enum class Columns { traced, straight, both };
 
-// Adds v (channel ch of `channels`) with trilinear weights st to the tally: to the straight column, to
-// the traced one and (times mu) the traced x cosine one, or to all three; with_pk: also pk (P_peak
-// towards the camera) to the fourth column.
-void splat(float* tally, int channels, bool with_pk, const TrilinearStencil& st, int ch, double v, double mu,
-           double pk, Columns to) {
+// Adds v (channel ch of `channels`) with trilinear weights st to the tally: to the straight column (and
+// times spread_s its spread column), to the traced one (and times spread its spread column), or to both
+// pairs; with_pk: also the traced v times pk (P_peak towards the camera) to the fifth column.
+void splat(float* tally, int channels, bool with_pk, const TrilinearStencil& st, int ch, double v,
+           double spread, double spread_s, double pk, Columns to) {
   const int stride = channels * (with_pk ? kCameraBlocks : kBaseBlocks);
   for (int j = 0; j < 8; ++j)
     if (st.weight[j] > 0.0) {
       float* node = &tally[st.node[j] * stride + ch];
       const double x = st.weight[j] * v;
-      if (to != Columns::traced) node[2 * channels] += float(x);
+      if (to != Columns::traced) {
+        node[2 * channels] += float(x);
+        node[3 * channels] += float(x * spread_s);
+      }
       if (to != Columns::straight) {
         node[0] += float(x);
-        node[channels] += float(x * mu);
-        if (with_pk) node[3 * channels] += float(x * pk);
+        node[channels] += float(x * spread);
+        if (with_pk) node[4 * channels] += float(x * pk);
       }
     }
 }
@@ -123,7 +138,9 @@ struct BeamPhotons {
   const std::vector<const PhaseSplit*>& splits;
   const std::vector<double>& peak_fraction;
   const TransmittanceGrid& T_wide;  // the light's reduced shadow map (empty: the closed-form chord)
+  const TransmittanceGrid& T_full;  // its full one, of the same layout (empty: the chord)
   bool chord;                       // T_wide by the chord (one constant-density shape: an empty map)
+  double one_minus_chi1;            // 1 - chi_1 of medium 0's peak (the straight model's spread)
   const NodeGrid& grid;
   size_t light;
   const PointLight* point;  // or null: a directional light
@@ -141,6 +158,9 @@ struct BeamPhotons {
 
   // T_wide from q to the light: the map, or the chord.
   Rgb wide(const Vec3& q) const;
+  // The straight model's spread 1 - mean cosine at q, 1 - exp(-tau (1 - chi_1)) for the peak depth tau =
+  // ln(T_wide / T_light) (eq. D3 at l = 1), and T_wide there.
+  Rgb straight_spread(const Vec3& q, Rgb* tw) const;
   void trace(size_t j, Rng& rng, PhotonBatch& batch) const;
   void sample(float* tally, const Vec3& q, const Vec3& w, double dl, Rgb* weight, int c, Columns to) const;
   Rgb deposit(float* tally, const Vec3& x, const Vec3& w, double t_end, Rgb weight, int c) const;
@@ -158,6 +178,25 @@ Rgb BeamPhotons::wide(const Vec3& q) const {
             : chord_full_and_reduced(ctx, q, -dir_w, inf, peak_fraction, &full, &reduced);
   NIMBUS_DCHECK(done);
   return done ? reduced : Rgb(1.0);
+}
+
+Rgb BeamPhotons::straight_spread(const Vec3& q, Rgb* tw) const {
+  Rgb full, reduced;
+  if (chord) {
+    const double inf = std::numeric_limits<double>::infinity();
+    const bool done =
+        point ? chord_full_and_reduced(ctx, q, normalize(point->position - q), (point->position - q).length(),
+                                       peak_fraction, &full, &reduced)
+              : chord_full_and_reduced(ctx, q, -dir_w, inf, peak_fraction, &full, &reduced);
+    NIMBUS_DCHECK(done);
+    if (!done) full = reduced = Rgb(1.0);
+  } else {
+    const TrilinearStencil st = T_wide.stencil(q);  // the pair's shared layout (build_pair)
+    reduced = T_wide.lookup(st);
+    full = T_full.lookup(st);
+  }
+  *tw = reduced;
+  return Rgb(1.0) - straight_mean_cosine(full, reduced, one_minus_chi1);
 }
 
 // One deposit sample at q (the midpoint of a step of length dl of the flight along w): the weight loses
@@ -180,11 +219,14 @@ void BeamPhotons::sample(float* tally, const Vec3& q, const Vec3& w, double dl, 
   }
   const Rgb mid = *weight * half;
   *weight = mid * half;
-  const Rgb tw = wide(q);
+  Rgb tw;
+  const Rgb spread_s = to != Columns::traced ? straight_spread(q, &tw) : Rgb(0.0);
+  if (to == Columns::traced) tw = wide(q);
   const double geo = point ? 1.0 / std::max(1e-300, dot(q - point->position, q - point->position)) : 1.0;
   const bool traced = to != Columns::straight;
-  // The cosine between the travel direction and the straight one from the light.
-  const double mu = !traced ? 1.0 : point ? dot(w, normalize(q - point->position)) : dot(w, dir_w);
+  // 1 - the cosine between the travel direction and the straight one from the light.
+  const double spread =
+      !traced ? 0.0 : 1.0 - (point ? dot(w, normalize(q - point->position)) : dot(w, dir_w));
   // The peak-only light's last peak scatter towards the camera (the forward-peak term's angular factor).
   const double pk = camera && traced ? splits[0]->peak(dot(w, normalize(*camera - q))) : 0.0;
   const TrilinearStencil st = grid.stencil(q);
@@ -192,7 +234,7 @@ void BeamPhotons::sample(float* tally, const Vec3& q, const Vec3& w, double dl, 
     if ((!grey && ch != c) || !(tw[ch] > 1e-30)) continue;
     const double v = mid[ch] * dl / (tw[ch] * geo);
     NIMBUS_DCHECK(v >= 0.0 && std::isfinite(v));
-    splat(tally, channels, camera != nullptr, st, ch, v, mu, pk, to);
+    splat(tally, channels, camera != nullptr, st, ch, v, spread, spread_s[ch], pk, to);
   }
 }
 
@@ -314,14 +356,18 @@ bool BeamPhotons::scatter(const Vec3& xc, Vec3* w, BeamWalk& walk, Rng& rng, Pho
 }  // namespace
 
 BeamGrid::BeamGrid(const SceneContext& ctx, const std::vector<const PhaseSplit*>& splits,
-                   const std::vector<double>& peak_fraction,
+                   const std::vector<double>& peak_fraction, const std::vector<TransmittanceGrid>& full_maps,
                    const std::vector<TransmittanceGrid>& reduced_maps, int photons, int resolution,
                    uint64_t seed, const Vec3* camera, const MajorantGrid* majorants, bool skip_idle)
     : with_camera_(camera != nullptr) {
   if (camera) camera_ = *camera;
   values_.resize(ctx.lights.size());
   const Bounds media_bounds = ctx.media.bounds();
-  if (media_bounds.empty() || photons <= 0 || reduced_maps.size() != ctx.lights.size()) return;
+  if (media_bounds.empty() || photons <= 0 || reduced_maps.size() != ctx.lights.size() ||
+      full_maps.size() != ctx.lights.size() || splits.empty())
+    return;
+  const std::vector<double>& chi = splits[0]->peak_moments();
+  one_minus_chi1_ = 1.0 - (chi.size() > 1 ? chi[1] : 1.0);
   grid_ = node_grid_padded(media_bounds, resolution);
   const bool grey = grey_media(ctx);
   channels_ = grey && grey_lights(ctx) ? 1 : 3;
@@ -348,7 +394,9 @@ BeamGrid::BeamGrid(const SceneContext& ctx, const std::vector<const PhaseSplit*>
                            .splits = splits,
                            .peak_fraction = peak_fraction,
                            .T_wide = reduced_maps[l],
+                           .T_full = full_maps[l],
                            .chord = reduced_maps[l].memory_bytes() == 0,
+                           .one_minus_chi1 = one_minus_chi1_,
                            .grid = grid_,
                            .light = l,
                            .point = point,
@@ -371,28 +419,34 @@ BeamGrid::BeamGrid(const SceneContext& ctx, const std::vector<const PhaseSplit*>
   }
 }
 
-bool BeamGrid::lookup(size_t light, const Vec3& p, Rgb* factor, Rgb* mean_cosine, Rgb* peak_toward) const {
+bool BeamGrid::lookup(size_t light, const Vec3& p, const Rgb& T_light, const Rgb& T_wide, Rgb* factor,
+                      Rgb* mean_cosine, Rgb* peak_toward) const {
   if (light >= values_.size() || values_[light].empty() || !grid_.bounds.contains(p)) return false;
-  return lookup(light, p, grid_.stencil(p), factor, mean_cosine, peak_toward);
+  return lookup(light, p, grid_.stencil(p), T_light, T_wide, factor, mean_cosine, peak_toward);
 }
 
-bool BeamGrid::lookup(size_t light, const Vec3& p, const TrilinearStencil& st, Rgb* factor, Rgb* mean_cosine,
-                      Rgb* peak_toward) const {
+bool BeamGrid::lookup(size_t light, const Vec3& p, const TrilinearStencil& st, const Rgb& T_light,
+                      const Rgb& T_wide, Rgb* factor, Rgb* mean_cosine, Rgb* peak_toward) const {
   if (light >= values_.size() || values_[light].empty() || !grid_.bounds.contains(p)) return false;
   const FloatArray& v = values_[light];
   const int n = channels_;
-  Rgb r(0.0), m(0.0), straight(0.0), pk(0.0);
+  Rgb r(0.0), spread(0.0), straight(0.0), spread_s(0.0), pk(0.0);
   for (int k = 0; k < 8; ++k)
     for (int c = 0; c < n; ++c) {
       const float* node = &v[st.node[k] * size_t(stride_) + c];
       r[c] += st.weight[k] * node[0];
-      m[c] += st.weight[k] * node[n];
+      spread[c] += st.weight[k] * node[n];
       straight[c] += st.weight[k] * node[2 * n];
-      if (with_camera_) pk[c] += st.weight[k] * node[3 * n];
+      spread_s[c] += st.weight[k] * node[3 * n];
+      if (with_camera_) pk[c] += st.weight[k] * node[4 * n];
     }
+  // The straight model's spread at p itself: the control variate of the tallies' spread (beam_grid.h).
+  const Rgb model = Rgb(1.0) - straight_mean_cosine(T_light, T_wide, one_minus_chi1_);
   for (int c = 0; c < n; ++c) {
     (*factor)[c] = straight[c] > 0.0 ? r[c] / straight[c] : 1.0;
-    (*mean_cosine)[c] = r[c] > 0.0 ? std::clamp(m[c] / r[c], -1.0, 1.0) : 1.0;
+    double s = r[c] > 0.0 ? spread[c] / r[c] : 0.0;
+    if (r[c] > 0.0 && straight[c] > 0.0) s += model[c] - spread_s[c] / straight[c];
+    (*mean_cosine)[c] = 1.0 - std::clamp(s, 0.0, 2.0);
     if (peak_toward) (*peak_toward)[c] = r[c] > 0.0 ? pk[c] / r[c] : 0.0;
   }
   if (n == 1) {  // channel 0 stands for all three

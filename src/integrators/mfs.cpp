@@ -202,7 +202,7 @@ MfsIntegrator::MfsIntegrator(const SceneContext& context, MfsSettings settings, 
     const Vec3 camera = ctx_.camera.origin();
     const bool toward = s_.peak_toward_camera && ctx_.media.count() == 1;
     beam_ =
-        std::make_unique<BeamGrid>(ctx_, splits, f_, reduced_maps_, s_.beam_photons,
+        std::make_unique<BeamGrid>(ctx_, splits, f_, full_maps_, reduced_maps_, s_.beam_photons,
                                    *s_.scatter_grid_resolution, seed, toward ? &camera : nullptr, tracking);
   }
   // Wide scatters 2 .. K from the scatter grid (for K = 1 only the environment's light).
@@ -238,15 +238,16 @@ void MfsIntegrator::build_maps() {
   for (const Light& l : ctx_.lights) {
     const int res = is_area_light(l) ? 8 : s_.shadow_map_resolution;  // area lights: a token map (light_beam)
     if (*s_.exact_light_transmittance) {
-      // light_beam reads the chord: only the beam grid's photons read a map (the reduced one; the
-      // same map as build_pair's), and on one constant-density shape they read the chord too (an empty
-      // map: BeamGrid).
-      full_maps_.emplace_back();
+      // light_beam reads the chord: only the beam grid's photons read the maps, and on one
+      // constant-density shape they read the chord too (empty maps: BeamGrid).
       const bool chord = ctx_.analytic.active() && ctx_.media.count() == 1;
-      if (s_.forward_light_path())
-        reduced_maps_.push_back(beam && !chord
-                                    ? TransmittanceGrid(ctx_.media, ctx_.majorants, l, res, map_step, f_)
-                                    : TransmittanceGrid());
+      if (s_.forward_light_path() && beam && !chord) {
+        TransmittanceGrid::build_pair(ctx_.media, ctx_.majorants, l, res, map_step, f_,
+                                      &full_maps_.emplace_back(), &reduced_maps_.emplace_back());
+      } else {
+        full_maps_.emplace_back();
+        if (s_.forward_light_path()) reduced_maps_.emplace_back();
+      }
     } else if (s_.forward_light_path()) {
       TransmittanceGrid::build_pair(ctx_.media, ctx_.majorants, l, res, map_step, f_,
                                     &full_maps_.emplace_back(), &reduced_maps_.emplace_back());
@@ -492,8 +493,8 @@ LightBeam MfsIntegrator::light_beam(size_t l, int i, const Vec3& p, const LightS
     T_wide = s_.forward_light_path() ? reduced_maps_[l].lookup(map_st) : T_light;
   }
   Rgb R(1.0), mean_cos(1.0), toward(0.0);
-  const bool traced = beam_ && (st ? beam_->lookup(l, p, *st, &R, &mean_cos, &toward)
-                                   : beam_->lookup(l, p, &R, &mean_cos, &toward));
+  const bool traced = beam_ && (st ? beam_->lookup(l, p, *st, T_light, T_wide, &R, &mean_cos, &toward)
+                                   : beam_->lookup(l, p, T_light, T_wide, &R, &mean_cos, &toward));
   LightBeam b = peak_only_beam(T_light, T_wide, traced, R, mean_cos, splits_[i]->peak_moments(), theta2_[i],
                                s_.forward_light_path() && s_.path_lengthening);
   if (traced && beam_->has_camera()) {

@@ -410,8 +410,9 @@ TEST(Mfs, BeamGridReproducesTheStraightBeamWithoutDeflection) {
       double t0, t1;
       ASSERT_TRUE(box.intersect(p, to_light, 0.0, tmax, &t0, &t1));
       Rgb R, mu;
-      ASSERT_TRUE(mfs.beam_grid()->lookup(l, p, &R, &mu));
       const Rgb T_map = maps[l].lookup(p);
+      // No scattering: T_light = T_wide, the straight model's mean cosine 1.
+      ASSERT_TRUE(mfs.beam_grid()->lookup(l, p, T_map, T_map, &R, &mu));
       for (int c = 0; c < 3; ++c) {
         const double exact = std::exp(-(0.5 + 0.5 * c) * (t1 - t0));
         err_map += std::abs(T_map[c] / exact - 1.0);
@@ -576,7 +577,7 @@ TEST(Mfs, BeamGridTalliesThePeakTowardsTheCamera) {
     const double z = 1.6 * rng.uniform() - 0.8, y = 1.6 * rng.uniform() - 0.8, x = 1.6 * rng.uniform() - 0.8;
     const Vec3 p(x, y, z);
     Rgb R, mc, toward;
-    ASSERT_TRUE(mfs.beam_grid()->lookup(0, p, &R, &mc, &toward));
+    ASSERT_TRUE(mfs.beam_grid()->lookup(0, p, Rgb(1.0), Rgb(1.0), &R, &mc, &toward));
     const double exact = mfs.split(0).peak(dot(travel, normalize(cam - p)));
     worst = std::max(worst, std::abs(toward[0] - exact) / (exact + 0.1));
     // The tally is P_peak averaged over the deposits near the nodes, read trilinearly: the curvature of
@@ -607,11 +608,13 @@ TEST(Mfs, BeamGridSkipsIdleCellsWithoutChangingTheMedia) {
   const MfsIntegrator mfs(ctx, ms);
   const std::vector<const PhaseSplit*> splits{&mfs.split(0), &mfs.split(1)};
   const std::vector<double> f{mfs.split(0).f(), mfs.split(1).f()};
-  std::vector<TransmittanceGrid> maps;
-  for (const Light& light : ctx.lights) maps.emplace_back(ctx.media, ctx.majorants, light, 32, 0.25, f);
+  std::vector<TransmittanceGrid> full, reduced;
+  for (const Light& light : ctx.lights)
+    TransmittanceGrid::build_pair(ctx.media, ctx.majorants, light, 32, 0.25, f, &full.emplace_back(),
+                                  &reduced.emplace_back());
   const Vec3 cam(0.0, -6.0, 0.0);
-  const BeamGrid skip(ctx, splits, f, maps, 4096, 40, 7, &cam, nullptr, true);
-  const BeamGrid all(ctx, splits, f, maps, 4096, 40, 7, &cam, nullptr, false);
+  const BeamGrid skip(ctx, splits, f, full, reduced, 4096, 40, 7, &cam, nullptr, true);
+  const BeamGrid all(ctx, splits, f, full, reduced, 4096, 40, 7, &cam, nullptr, false);
   std::printf("beam grid: idle share of the cells %.3f\n", skip.idle_share());
   EXPECT_GT(skip.idle_share(), 0.2);
   EXPECT_EQ(all.idle_share(), 0.0);
@@ -624,8 +627,9 @@ TEST(Mfs, BeamGridSkipsIdleCellsWithoutChangingTheMedia) {
     const bool in_gap = std::abs(x) < 0.5;
     for (size_t l = 0; l < 2; ++l) {
       Rgb R[2], mc[2], pk[2];
-      ASSERT_TRUE(skip.lookup(l, p, &R[0], &mc[0], &pk[0]));
-      ASSERT_TRUE(all.lookup(l, p, &R[1], &mc[1], &pk[1]));
+      const Rgb T_light = full[l].lookup(p), T_wide = reduced[l].lookup(p);
+      ASSERT_TRUE(skip.lookup(l, p, T_light, T_wide, &R[0], &mc[0], &pk[0]));
+      ASSERT_TRUE(all.lookup(l, p, T_light, T_wide, &R[1], &mc[1], &pk[1]));
       for (int c = 0; c < 3; ++c) {
         if (in_media) {
           EXPECT_EQ(R[0][c], R[1][c]) << "light " << l << " at " << x << " " << y << " " << z;
@@ -642,6 +646,40 @@ TEST(Mfs, BeamGridSkipsIdleCellsWithoutChangingTheMedia) {
               gap_differs, gap);
   EXPECT_GT(inside, 300);
   EXPECT_GT(gap_differs, gap / 2);
+}
+
+// The peak-only beam's spread (1 - its mean cosine) grows from 0 at a lit face over less than a node
+// spacing here (a wide slab, 3 nodes through its thickness). Far from the slab's sides nothing spreads
+// out of it, and the traced spread is the straight model's, 1 - exp(-tau (1 - chi_1)) at the peak depth
+// tau = ln(T_wide / T_light), times about 1.12 over the first half of the slab (1.2 deeper: the photons'
+// paths are longer than the depth, and oblique ones leave more track per unit depth). Read at a point, it
+// must follow the model at that point, not the average of the nodes around it, which is several times
+// the model's spread near the lit face (without the straight deposits' control variate).
+TEST(Mfs, BeamGridSpreadFollowsTheStraightModelWithinACell) {
+  const Scene scene = test::scene_from_json("{" + test::camera_json(8, 8) + R"(,
+    "media": [{"shape": {"type": "box", "min": [-6, -6, -1], "max": [6, 6, 1]}, "sigma_s": 2.0, "sigma_a": 0.0,
+               "phase": {"type": "hg", "g": 0.9}}],
+    "lights": [{"type": "directional", "direction": [0, 0, -1], "irradiance": 1.0}]})");
+  const SceneContext ctx(scene);
+  MfsSettings ms = mfs_settings_from_json(nlohmann::json::object(), "test");
+  ms.large_angle_scatters = 0;
+  ms.beam_photons = 1 << 17;
+  ms.scatter_grid_resolution = 16;
+  const MfsIntegrator mfs(ctx, ms);
+  ASSERT_NE(mfs.beam_grid(), nullptr);
+  const double f = mfs.split(0).f(), e = 1.0 - mfs.split(0).peak_moments()[1];
+  double worst = 0.0;
+  for (int i = 0; i <= 24; ++i) {
+    const double depth = 1.2 * i / 24.0;
+    const Vec3 p(0.3, -0.2, 1.0 - depth);
+    const Rgb T_light(std::exp(-2.0 * depth)), T_wide(std::exp(-(1.0 - f) * 2.0 * depth));
+    Rgb R, mc;
+    ASSERT_TRUE(mfs.beam_grid()->lookup(0, p, T_light, T_wide, &R, &mc));
+    const double model = 1.0 - std::exp(-f * 2.0 * depth * e);
+    worst = std::max(worst, std::abs((1.0 - mc[0]) - 1.12 * model));
+    EXPECT_NEAR(1.0 - mc[0], 1.12 * model, 0.06 * model + 5e-4) << "at depth " << depth;
+  }
+  std::printf("beam spread in a lit slab: worst |spread - 1.12 x the straight model's| %.4f\n", worst);
 }
 
 // The closed-form transmittances on one constant-density shape (the beam grid's T_wide and `mfs`'s light
@@ -709,9 +747,11 @@ TEST(Mfs, BeamGridKeepsOneChannelForGreyMediaAndGreyLights) {
     const MfsIntegrator mfs(ctx, ms);
     const std::vector<const PhaseSplit*> splits{&mfs.split(0)};
     const std::vector<double> f{mfs.split(0).f()};
-    std::vector<TransmittanceGrid> maps;
-    for (const Light& light : ctx.lights) maps.emplace_back(ctx.media, ctx.majorants, light, 32, 0.25, f);
-    return BeamGrid(ctx, splits, f, maps, 4096, 24, 7, camera ? &cam : nullptr);
+    std::vector<TransmittanceGrid> full, reduced;
+    for (const Light& light : ctx.lights)
+      TransmittanceGrid::build_pair(ctx.media, ctx.majorants, light, 32, 0.25, f, &full.emplace_back(),
+                                    &reduced.emplace_back());
+    return BeamGrid(ctx, splits, f, full, reduced, 4096, 24, 7, camera ? &cam : nullptr);
   };
   EXPECT_EQ(grid(chromatic, false).channels(), 3);
   for (const bool camera : {false, true}) {
@@ -725,8 +765,9 @@ TEST(Mfs, BeamGridKeepsOneChannelForGreyMediaAndGreyLights) {
       const double x = 2 * rng.uniform() - 1, y = 2 * rng.uniform() - 1, z = 2 * rng.uniform() - 1;
       const Vec3 p(x, y, z);
       Rgb R[2], mc[2], pk[2];
-      ASSERT_TRUE(one.lookup(0, p, &R[0], &mc[0], camera ? &pk[0] : nullptr));
-      ASSERT_TRUE(three.lookup(0, p, &R[1], &mc[1], camera ? &pk[1] : nullptr));
+      const Rgb T_light(0.3), T_wide(0.6);  // the straight model's at p: the same for both grids
+      ASSERT_TRUE(one.lookup(0, p, T_light, T_wide, &R[0], &mc[0], camera ? &pk[0] : nullptr));
+      ASSERT_TRUE(three.lookup(0, p, T_light, T_wide, &R[1], &mc[1], camera ? &pk[1] : nullptr));
       for (int c = 0; c < 3; ++c) {
         EXPECT_EQ(R[0][c], R[1][0]) << "at " << x << " " << y << " " << z;
         EXPECT_EQ(mc[0][c], mc[1][0]) << "at " << x << " " << y << " " << z;
