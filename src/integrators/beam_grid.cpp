@@ -14,10 +14,15 @@
 namespace nimbus {
 namespace {
 
-// Per node, in blocks of `channels` floats (3: rgb; 1: grey media under lights of grey strength, whose
-// three channels would be the same numbers): traced, traced x (1 - cosine), straight, straight x the
-// straight model's 1 - mean cosine, and with a camera (peak_toward) traced x P_peak towards the camera.
-constexpr int kBaseBlocks = 4, kCameraBlocks = 5;
+// Per node, blocks of `channels` floats (3: rgb; 1: grey media under lights of grey strength, whose three
+// channels would be the same numbers), in this order: traced, straight; with the spread (beam_spread
+// "traced"), traced x (1 - cosine) and straight x the straight model's 1 - mean cosine; with a camera
+// (peak_toward), traced x P_peak towards the camera.
+struct Blocks {
+  bool spread, pk;
+  int count() const { return 2 + (spread ? 2 : 0) + (pk ? 1 : 0); }
+  int pk_block() const { return spread ? 4 : 2; }
+};
 constexpr double kR2a1 = 0.75487766624669276, kR2a2 = 0.56984029099805327;  // the R2 sequence
 constexpr double kRoulette = 0.05;  // roulette below this ratio of weight to T_wide
 // Deposit samples (and the loss's midpoint rule) at most this many node spacings apart: 1 (0.5 before,
@@ -43,23 +48,23 @@ Rgb straight_mean_cosine(const Rgb& full, const Rgb& reduced, double one_minus_c
 enum class Columns { traced, straight, both };
 
 // Adds v (channel ch of `channels`) with trilinear weights st to the tally: to the straight column (and
-// times spread_s its spread column), to the traced one (and times spread its spread column), or to both
-// pairs; with_pk: also the traced v times pk (P_peak towards the camera) to the fifth column.
-void splat(float* tally, int channels, bool with_pk, const TrilinearStencil& st, int ch, double v,
-           double spread, double spread_s, double pk, Columns to) {
-  const int stride = channels * (with_pk ? kCameraBlocks : kBaseBlocks);
+// times spread_s its spread column), to the traced one (and times spread its spread column), or to both;
+// with a P_peak block also the traced v times pk (P_peak towards the camera).
+void splat(float* tally, int channels, Blocks b, const TrilinearStencil& st, int ch, double v, double spread,
+           double spread_s, double pk, Columns to) {
+  const int stride = channels * b.count();
   for (int j = 0; j < 8; ++j)
     if (st.weight[j] > 0.0) {
       float* node = &tally[st.node[j] * stride + ch];
       const double x = st.weight[j] * v;
       if (to != Columns::traced) {
-        node[2 * channels] += float(x);
-        node[3 * channels] += float(x * spread_s);
+        node[channels] += float(x);
+        if (b.spread) node[3 * channels] += float(x * spread_s);
       }
       if (to != Columns::straight) {
         node[0] += float(x);
-        node[channels] += float(x * spread);
-        if (with_pk) node[4 * channels] += float(x * pk);
+        if (b.spread) node[2 * channels] += float(x * spread);
+        if (b.pk) node[b.pk_block() * channels] += float(x * pk);
       }
     }
 }
@@ -141,6 +146,7 @@ struct BeamPhotons {
   const TransmittanceGrid& T_full;  // its full one, of the same layout (empty: the chord)
   bool chord;                       // T_wide by the chord (one constant-density shape: an empty map)
   double one_minus_chi1;            // 1 - chi_1 of medium 0's peak (the straight model's spread)
+  Blocks blocks;                    // the node's columns
   const NodeGrid& grid;
   size_t light;
   const PointLight* point;  // or null: a directional light
@@ -220,13 +226,15 @@ void BeamPhotons::sample(float* tally, const Vec3& q, const Vec3& w, double dl, 
   const Rgb mid = *weight * half;
   *weight = mid * half;
   Rgb tw;
-  const Rgb spread_s = to != Columns::traced ? straight_spread(q, &tw) : Rgb(0.0);
-  if (to == Columns::traced) tw = wide(q);
+  const bool spread_s_wanted = blocks.spread && to != Columns::traced;
+  const Rgb spread_s = spread_s_wanted ? straight_spread(q, &tw) : Rgb(0.0);
+  if (!spread_s_wanted) tw = wide(q);
   const double geo = point ? 1.0 / std::max(1e-300, dot(q - point->position, q - point->position)) : 1.0;
   const bool traced = to != Columns::straight;
   // 1 - the cosine between the travel direction and the straight one from the light.
-  const double spread =
-      !traced ? 0.0 : 1.0 - (point ? dot(w, normalize(q - point->position)) : dot(w, dir_w));
+  const double spread = !(blocks.spread && traced)
+                            ? 0.0
+                            : 1.0 - (point ? dot(w, normalize(q - point->position)) : dot(w, dir_w));
   // The peak-only light's last peak scatter towards the camera (the forward-peak term's angular factor).
   const double pk = camera && traced ? splits[0]->peak(dot(w, normalize(*camera - q))) : 0.0;
   const TrilinearStencil st = grid.stencil(q);
@@ -234,7 +242,7 @@ void BeamPhotons::sample(float* tally, const Vec3& q, const Vec3& w, double dl, 
     if ((!grey && ch != c) || !(tw[ch] > 1e-30)) continue;
     const double v = mid[ch] * dl / (tw[ch] * geo);
     NIMBUS_DCHECK(v >= 0.0 && std::isfinite(v));
-    splat(tally, channels, camera != nullptr, st, ch, v, spread, spread_s[ch], pk, to);
+    splat(tally, channels, blocks, st, ch, v, spread, spread_s[ch], pk, to);
   }
 }
 
@@ -358,20 +366,21 @@ bool BeamPhotons::scatter(const Vec3& xc, Vec3* w, BeamWalk& walk, Rng& rng, Pho
 BeamGrid::BeamGrid(const SceneContext& ctx, const std::vector<const PhaseSplit*>& splits,
                    const std::vector<double>& peak_fraction, const std::vector<TransmittanceGrid>& full_maps,
                    const std::vector<TransmittanceGrid>& reduced_maps, int photons, int resolution,
-                   uint64_t seed, const Vec3* camera, const MajorantGrid* majorants, bool skip_idle)
-    : with_camera_(camera != nullptr) {
+                   uint64_t seed, bool spread, const Vec3* camera, const MajorantGrid* majorants,
+                   bool skip_idle)
+    : with_camera_(camera != nullptr), spread_(spread) {
   if (camera) camera_ = *camera;
   values_.resize(ctx.lights.size());
   const Bounds media_bounds = ctx.media.bounds();
   if (media_bounds.empty() || photons <= 0 || reduced_maps.size() != ctx.lights.size() ||
       full_maps.size() != ctx.lights.size() || splits.empty())
     return;
-  const std::vector<double>& chi = splits[0]->peak_moments();
-  one_minus_chi1_ = 1.0 - (chi.size() > 1 ? chi[1] : 1.0);
+  one_minus_chi1_ = 1.0 - (splits[0]->peak_moments().size() > 1 ? splits[0]->peak_moments()[1] : 1.0);
   grid_ = node_grid_padded(media_bounds, resolution);
   const bool grey = grey_media(ctx);
   channels_ = grey && grey_lights(ctx) ? 1 : 3;
-  stride_ = channels_ * (camera ? kCameraBlocks : kBaseBlocks);
+  const Blocks blocks{.spread = spread, .pk = camera != nullptr};
+  stride_ = channels_ * blocks.count();
   // Chromatic media: one pass per channel, the light's photons shared among them (a third each: the
   // suite's chromatic box had the same error with a third as with all three times over, at 0.8x the
   // set-up; docs/benchmarks.md).
@@ -397,6 +406,7 @@ BeamGrid::BeamGrid(const SceneContext& ctx, const std::vector<const PhaseSplit*>
                            .T_full = full_maps[l],
                            .chord = reduced_maps[l].memory_bytes() == 0,
                            .one_minus_chi1 = one_minus_chi1_,
+                           .blocks = blocks,
                            .grid = grid_,
                            .light = l,
                            .point = point,
@@ -430,28 +440,36 @@ bool BeamGrid::lookup(size_t light, const Vec3& p, const TrilinearStencil& st, c
   if (light >= values_.size() || values_[light].empty() || !grid_.bounds.contains(p)) return false;
   const FloatArray& v = values_[light];
   const int n = channels_;
-  Rgb r(0.0), spread(0.0), straight(0.0), spread_s(0.0), pk(0.0);
+  const Blocks blocks{.spread = spread_, .pk = with_camera_};
+  const bool spread = spread_ && mean_cosine, pk_wanted = with_camera_ && peak_toward;
+  Rgb r(0.0), straight(0.0), sp(0.0), sp_s(0.0), pk(0.0);
   for (int k = 0; k < 8; ++k)
     for (int c = 0; c < n; ++c) {
       const float* node = &v[st.node[k] * size_t(stride_) + c];
       r[c] += st.weight[k] * node[0];
-      spread[c] += st.weight[k] * node[n];
-      straight[c] += st.weight[k] * node[2 * n];
-      spread_s[c] += st.weight[k] * node[3 * n];
-      if (with_camera_) pk[c] += st.weight[k] * node[4 * n];
+      straight[c] += st.weight[k] * node[n];
+      if (spread) {
+        sp[c] += st.weight[k] * node[2 * n];
+        sp_s[c] += st.weight[k] * node[3 * n];
+      }
+      if (pk_wanted) pk[c] += st.weight[k] * node[blocks.pk_block() * n];
     }
-  // The straight model's spread at p itself: the control variate of the tallies' spread (beam_grid.h).
-  const Rgb model = Rgb(1.0) - straight_mean_cosine(T_light, T_wide, one_minus_chi1_);
+  // The straight model's spread at p itself: the control variate of the tallies' spread (eq. D9b).
+  const Rgb model =
+      mean_cosine ? Rgb(1.0) - straight_mean_cosine(T_light, T_wide, one_minus_chi1_) : Rgb(0.0);
   for (int c = 0; c < n; ++c) {
     (*factor)[c] = straight[c] > 0.0 ? r[c] / straight[c] : 1.0;
-    double s = r[c] > 0.0 ? spread[c] / r[c] : 0.0;
-    if (r[c] > 0.0 && straight[c] > 0.0) s += model[c] - spread_s[c] / straight[c];
-    (*mean_cosine)[c] = 1.0 - std::clamp(s, 0.0, 2.0);
+    if (mean_cosine) {
+      double s = model[c];
+      if (spread && r[c] > 0.0)
+        s = sp[c] / r[c] + (straight[c] > 0.0 ? model[c] - sp_s[c] / straight[c] : 0.0);
+      (*mean_cosine)[c] = 1.0 - std::clamp(s, 0.0, 2.0);
+    }
     if (peak_toward) (*peak_toward)[c] = r[c] > 0.0 ? pk[c] / r[c] : 0.0;
   }
   if (n == 1) {  // channel 0 stands for all three
     *factor = Rgb((*factor)[0]);
-    *mean_cosine = Rgb((*mean_cosine)[0]);
+    if (mean_cosine) *mean_cosine = Rgb((*mean_cosine)[0]);
     if (peak_toward) *peak_toward = Rgb((*peak_toward)[0]);
   }
   return true;

@@ -13,15 +13,17 @@
 // irradiance or I / r^2), and the same photon is deposited once more undeflected (the model itself, with
 // the same emission: a control variate), so R = traced / straight is 1 wherever nothing deflects the
 // light; a photon's first flight and its straight deposit share their samples up to its first peak
-// scatter. Photons enter through a stratified disc or cone (the R2 sequence). The traced deposits also
-// carry 1 - the cosine to the straight direction from the light: the beam's spread, 1 - its mean cosine,
-// which sets the angular spread `mfs` gives the peak-only light. The straight deposits carry the straight
+// scatter. Photons enter through a stratified disc or cone (the R2 sequence). With `spread` (beam_spread
+// "traced"), the traced deposits also carry 1 - the cosine to the straight direction from the light: the
+// beam's spread, 1 - its mean cosine, which then sets the angular spread `mfs` gives the peak-only light
+// (by default it keeps the straight beam's spread, which is closer to the path tracer on the suite's
+// backlit spheres: docs/benchmarks.md, "The beam's spread"). The straight deposits then carry the straight
 // model's spread, 1 - exp(-tau (1 - chi_1)) at its peak depth tau = ln(T_wide / T_light) (eq. D3 at l = 1),
 // as its control variate: the spread read at p is the traced spread as tallied, plus the model's at p,
 // minus the model's as tallied. Where the spread changes faster than the nodes resolve (the lit side of a
 // dense medium, where it grows from 0 at the surface) the model's exact value at p carries the change and
-// the nodes only the difference: a cell-averaged spread made the lit rim of a backlit sphere too dark
-// (docs/benchmarks.md, "The beam's spread"). `mfs` multiplies T_wide by R. Deposits in cells with no
+// the nodes only the difference (eq. D9b): a cell-averaged spread made the lit rim of a backlit sphere too
+// dark. `mfs` multiplies T_wide by R. Deposits in cells with no
 // medium in or next to them are skipped (nothing there is read where a medium scatters), so far from
 // the media (the grid's padding, the empty space and the shadows within its bounds) R is incomplete.
 #pragma once
@@ -40,17 +42,20 @@ namespace nimbus {
 class BeamGrid {
  public:
   // full_maps[l], reduced_maps[l]: light l's T_light and T_wide, a pair of one layout (build_pair; empty
-  // maps: the chord in closed form, for one constant-density sphere or box only); photons: per light;
-  // resolution as ScatterGridSettings. The straight model's spread takes medium 0's chi_1.
+  // maps: the chord in closed form, for one constant-density sphere or box only; the full maps are read
+  // only with `spread`); photons: per light; resolution as ScatterGridSettings. spread: tally the spread
+  // (the straight model's takes medium 0's chi_1).
   // skip_idle: no deposits in cells with no medium in them or next to them (the lookup is the same
   // wherever there is a medium; for tests: false deposits everywhere).
   BeamGrid(const SceneContext& ctx, const std::vector<const PhaseSplit*>& splits,
            const std::vector<double>& peak_fraction, const std::vector<TransmittanceGrid>& full_maps,
            const std::vector<TransmittanceGrid>& reduced_maps, int photons, int resolution, uint64_t seed,
-           const Vec3* camera = nullptr, const MajorantGrid* majorants = nullptr, bool skip_idle = true);
-  // R for light `light` at p (trilinear between nodes) and the peak-only light's mean cosine to the
-  // straight direction from the light, given the straight model's T_light and T_wide at p (the spread's
-  // control variate); false (nothing written) outside the grid and for other lights.
+           bool spread, const Vec3* camera = nullptr, const MajorantGrid* majorants = nullptr,
+           bool skip_idle = true);
+  // R for light `light` at p (trilinear between nodes) and, if mean_cosine is not null, the peak-only
+  // light's mean cosine to the straight direction from the light, given the straight model's T_light and
+  // T_wide at p (the spread's control variate; a grid without `spread`: the straight model's); false
+  // (nothing written) outside the grid and for other lights.
   // With a camera, peak_toward (if not null) gets the traced beam's P_peak (medium 0's) towards the camera,
   // averaged over its directions: the angular factor of the forward peak alone (eq. D7's peak_eff).
   bool lookup(size_t light, const Vec3& p, const Rgb& T_light, const Rgb& T_wide, Rgb* factor,
@@ -72,11 +77,12 @@ class BeamGrid {
 
  private:
   NodeGrid grid_;                   // the media's bounds padded by one spacing (node_grid_padded)
-  std::vector<FloatArray> values_;  // per light and node: traced, its spread, straight, its spread (, P_peak)
+  std::vector<FloatArray> values_;  // per light and node: traced, straight (, their spreads) (, P_peak)
   double one_minus_chi1_ = 0.0;     // medium 0's peak: the straight model's spread
   uint64_t rejection_failures_ = 0;
   double idle_share_ = 0.0;
-  bool with_camera_;  // the nodes hold a fourth column, P_peak towards camera_
+  bool with_camera_;  // the nodes hold a column of P_peak towards camera_
+  bool spread_;       // the nodes hold the traced and the straight spread
   int channels_ = 3;  // floats per column
   int stride_ = 0;    // floats per node
   Vec3 camera_{0.0};  // the point P_peak is tallied towards

@@ -20,6 +20,7 @@ namespace nimbus {
 
 namespace {
 const std::vector<std::string> kLightPathNames = {"forward", "beer_lambert"};
+const std::vector<std::string> kBeamSpreadNames = {"straight", "traced"};  // as BeamSpread
 const std::vector<std::string> kPropagatorNames = {"gsa", "gaussian"};
 const std::vector<std::string> kPhotonTransportNames = {"exact", "similarity"};
 const std::vector<std::string> kForwardSideNames = {"camera", "light"};
@@ -45,6 +46,7 @@ MfsSettings mfs_settings_from_json(const nlohmann::json& options, const std::str
   s.scatter_grid_bands = int(o.integer("scatter_grid_bands", 1, kShMaxBands, s.scatter_grid_bands));
   s.forward_side = ForwardSide(o.choice("forward_side", kForwardSideNames, int(s.forward_side)));
   s.beam_photons = int(o.integer("beam_photons", 0, 1 << 24, s.beam_photons));
+  s.beam_spread = BeamSpread(o.choice("beam_spread", kBeamSpreadNames, int(s.beam_spread)));
   s.photon_splat = Splat(o.choice("photon_splat", kSplatNames, int(s.photon_splat)));
   s.light_blur = o.boolean("light_blur", s.light_blur);
   s.path_lengthening = o.boolean("path_lengthening", s.path_lengthening);
@@ -77,6 +79,7 @@ nlohmann::json to_json(const MfsSettings& s) {
                       {"scatter_grid_bands", s.scatter_grid_bands},
                       {"forward_side", kForwardSideNames[int(s.forward_side)]},
                       {"beam_photons", s.beam_photons},
+                      {"beam_spread", kBeamSpreadNames[int(s.beam_spread)]},
                       {"photon_splat", kSplatNames[int(s.photon_splat)]},
                       {"light_blur", s.light_blur},
                       {"path_lengthening", s.path_lengthening},
@@ -201,9 +204,9 @@ MfsIntegrator::MfsIntegrator(const SceneContext& context, MfsSettings settings, 
     // peak_toward_camera: the beam's P_peak towards the camera tallied too (one medium only).
     const Vec3 camera = ctx_.camera.origin();
     const bool toward = s_.peak_toward_camera && ctx_.media.count() == 1;
-    beam_ =
-        std::make_unique<BeamGrid>(ctx_, splits, f_, full_maps_, reduced_maps_, s_.beam_photons,
-                                   *s_.scatter_grid_resolution, seed, toward ? &camera : nullptr, tracking);
+    beam_ = std::make_unique<BeamGrid>(
+        ctx_, splits, f_, full_maps_, reduced_maps_, s_.beam_photons, *s_.scatter_grid_resolution, seed,
+        s_.beam_spread == BeamSpread::traced, toward ? &camera : nullptr, tracking);
   }
   // Wide scatters 2 .. K from the scatter grid (for K = 1 only the environment's light).
   if (s_.large_angle_scatters != 0 &&
@@ -238,15 +241,19 @@ void MfsIntegrator::build_maps() {
   for (const Light& l : ctx_.lights) {
     const int res = is_area_light(l) ? 8 : s_.shadow_map_resolution;  // area lights: a token map (light_beam)
     if (*s_.exact_light_transmittance) {
-      // light_beam reads the chord: only the beam grid's photons read the maps, and on one
-      // constant-density shape they read the chord too (empty maps: BeamGrid).
+      // light_beam reads the chord: only the beam grid's photons read the maps (the reduced one, and
+      // for the traced spread the full one too), and on one constant-density shape they read the chord
+      // too (empty maps: BeamGrid).
       const bool chord = ctx_.analytic.active() && ctx_.media.count() == 1;
-      if (s_.forward_light_path() && beam && !chord) {
+      if (s_.forward_light_path() && beam && !chord && s_.beam_spread == BeamSpread::traced) {
         TransmittanceGrid::build_pair(ctx_.media, ctx_.majorants, l, res, map_step, f_,
                                       &full_maps_.emplace_back(), &reduced_maps_.emplace_back());
       } else {
         full_maps_.emplace_back();
-        if (s_.forward_light_path()) reduced_maps_.emplace_back();
+        if (s_.forward_light_path())
+          reduced_maps_.push_back(beam && !chord
+                                      ? TransmittanceGrid(ctx_.media, ctx_.majorants, l, res, map_step, f_)
+                                      : TransmittanceGrid());
       }
     } else if (s_.forward_light_path()) {
       TransmittanceGrid::build_pair(ctx_.media, ctx_.majorants, l, res, map_step, f_,
@@ -465,7 +472,7 @@ LightBeam MfsIntegrator::environment_beam(int i, const Vec3& p, const Vec3& wi) 
   marched_full_and_reduced(ctx_, p, wi, std::numeric_limits<double>::infinity(), kSurfaceShadowStep, f_,
                            &T_light, &T_wide);
   if (!s_.forward_light_path()) T_wide = T_light;
-  return peak_only_beam(T_light, T_wide, false, Rgb(1.0), Rgb(1.0), splits_[i]->peak_moments(), theta2_[i],
+  return peak_only_beam(T_light, T_wide, false, Rgb(1.0), nullptr, splits_[i]->peak_moments(), theta2_[i],
                         s_.forward_light_path() && s_.path_lengthening);
 }
 
@@ -493,9 +500,10 @@ LightBeam MfsIntegrator::light_beam(size_t l, int i, const Vec3& p, const LightS
     T_wide = s_.forward_light_path() ? reduced_maps_[l].lookup(map_st) : T_light;
   }
   Rgb R(1.0), mean_cos(1.0), toward(0.0);
-  const bool traced = beam_ && (st ? beam_->lookup(l, p, *st, T_light, T_wide, &R, &mean_cos, &toward)
-                                   : beam_->lookup(l, p, T_light, T_wide, &R, &mean_cos, &toward));
-  LightBeam b = peak_only_beam(T_light, T_wide, traced, R, mean_cos, splits_[i]->peak_moments(), theta2_[i],
+  Rgb* spread = s_.beam_spread == BeamSpread::traced ? &mean_cos : nullptr;  // else the straight beam's
+  const bool traced = beam_ && (st ? beam_->lookup(l, p, *st, T_light, T_wide, &R, spread, &toward)
+                                   : beam_->lookup(l, p, T_light, T_wide, &R, spread, &toward));
+  LightBeam b = peak_only_beam(T_light, T_wide, traced, R, spread, splits_[i]->peak_moments(), theta2_[i],
                                s_.forward_light_path() && s_.path_lengthening);
   if (traced && beam_->has_camera()) {
     b.toward = true;

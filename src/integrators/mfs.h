@@ -44,6 +44,7 @@
 // | `scatter_grid_bands`      | integer in [1, 3]             | 3         | spherical-harmonic bands used at lookup (l < bands) |
 // | `forward_side`            | "camera" or "light"           | "camera"  | peak scatters after the last wide scatter carried to the camera, or taken on the light's side with an exact camera leg |
 // | `beam_photons`            | integer in [0, 2^24]          | 32768     | photons per light for the peak-only beam grid, shared among the channels' passes in chromatic media (0: straight beams) |
+// | `beam_spread`             | "straight" or "traced"        | "straight" | the peak-only light's angular spread: the straight beam's peak depth ln(T_wide / T_light) (D8), or the beam grid's photons' mean cosine read against the straight beam's (D9b; backlit spheres' binned error 1.4x, docs/benchmarks.md "The beam's spread") |
 // | `photon_splat`            | "trilinear", "stochastic" or "stratified" | "trilinear" | how the scatter grid's photons deposit each track sample: over the 8 nodes around it, or whole to one of them drawn by its trilinear weight (independently, or stratified along the track); the same expected grid, more noise (the beam grid stays trilinear) |
 // | `light_blur`              | boolean                       | true      | the first wide scatter sees the beam's light-side angular spread |
 // | `path_lengthening`        | boolean                       | false     | the corrected kernel's 1 / cosh loss on paths lengthened by peak deflections |
@@ -76,6 +77,7 @@ enum class LightPath { forward, beer_lambert };
 enum class Propagator { gsa, gaussian };
 enum class PhotonTransport { exact, similarity };
 enum class ForwardSide { camera, light };
+enum class BeamSpread { straight, traced };
 
 // The camera march's step in the majorant cells where a medium may emit: at most this optical depth (and
 // tau_step where that is finer). The emission's spatial variation is not blurred by the propagator, so it
@@ -96,6 +98,7 @@ struct MfsSettings {
   int scatter_grid_bands = 3;
   ForwardSide forward_side = ForwardSide::camera;
   int beam_photons = 1 << 15;
+  BeamSpread beam_spread = BeamSpread::straight;
   Splat photon_splat = Splat::trilinear;
   bool light_blur = true;
   bool path_lengthening = false;

@@ -125,24 +125,24 @@ Vec3 lateral_offset(const Vec3& d, double sigma, double u1, double u2) {
 }
 
 LightBeam peak_only_beam(const Rgb& T_light, const Rgb& T_wide, bool traced, const Rgb& R,
-                         const Rgb& mean_cos, const std::vector<double>& peak_moments, double theta2,
+                         const Rgb* mean_cos, const std::vector<double>& peak_moments, double theta2,
                          bool lengthening) {
   LightBeam b{T_light, T_wide, Rgb(0.0)};
   const double one_minus_chi1 = 1.0 - (peak_moments.size() > 1 ? peak_moments[1] : 1.0);
   // A channel equal to the one before it in every input takes that channel's values (grey media: one log
   // instead of three; the same values bit for bit).
   for (int c = 0; c < 3; ++c) {
-    if (traced) {
-      // eq. D9: the traced beam's loss R, and the peak depth whose spread has its mean cosine (eq. D3
-      // at l = 1: mean_cos = exp(-tau_ps (1 - chi_1^peak))).
-      b.T_wide[c] *= R[c];
-      if (c > 0 && mean_cos[c] == mean_cos[c - 1]) {
+    if (traced && mean_cos) {
+      // eq. D9: the peak depth whose spread has the traced beam's mean cosine (eq. D3 at l = 1:
+      // mean_cos = exp(-tau_ps (1 - chi_1^peak))).
+      if (c > 0 && (*mean_cos)[c] == (*mean_cos)[c - 1]) {
         b.tau_ps[c] = b.tau_ps[c - 1];
         continue;
       }
-      b.tau_ps[c] = one_minus_chi1 > 0.0 ? std::min(PhaseSplit::kTauMax,
-                                                    -std::log(std::max(mean_cos[c], 1e-12)) / one_minus_chi1)
-                                         : 0.0;
+      b.tau_ps[c] =
+          one_minus_chi1 > 0.0
+              ? std::min(PhaseSplit::kTauMax, -std::log(std::max((*mean_cos)[c], 1e-12)) / one_minus_chi1)
+              : 0.0;
       continue;
     }
     if (c > 0 && T_light[c] == T_light[c - 1] && T_wide[c] == T_wide[c - 1]) {
@@ -153,9 +153,11 @@ LightBeam peak_only_beam(const Rgb& T_light, const Rgb& T_wide, bool traced, con
     // eq. D8: the straight beam's peak depth ln(T_wide / T_light), and optionally eq. D5.
     b.tau_ps[c] =
         T_light[c] > 1e-30 ? std::max(0.0, std::log(b.T_wide[c] / T_light[c])) : PhaseSplit::kTauMax;
-    if (lengthening && b.T_wide[c] > 0.0)
+    if (!traced && lengthening && b.T_wide[c] > 0.0)
       b.T_wide[c] *= path_lengthening(theta2 * b.tau_ps[c], -std::log(b.T_wide[c]));
   }
+  // eq. D9: the traced beam's loss R (its lengthened paths included: no eq. D5).
+  if (traced) b.T_wide *= R;
   return b;
 }
 

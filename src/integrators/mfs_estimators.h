@@ -100,11 +100,13 @@ struct LightBeam {
   bool toward = false;
   Rgb peak_toward{0.0};
 };
-// From the shadow maps' T_light and T_wide, and from the beam grid where it covers y (traced: R and the
-// beam's mean cosine); peak_moments: the medium's chi_l^peak; theta2: its peak's mean square angle.
-// path_lengthening (forward light path only) applies eq. D5 to the straight beam.
+// From the shadow maps' T_light and T_wide, and from the beam grid where it covers y (traced: T_wide times
+// R, and with mean_cos the spread from the beam's mean cosine, eq. D9; without it, or not traced, the
+// straight beam's peak depth ln(T_wide / T_light), eq. D8); peak_moments: the medium's chi_l^peak;
+// theta2: its peak's mean square angle. path_lengthening (forward light path only) applies eq. D5 to the
+// straight beam.
 LightBeam peak_only_beam(const Rgb& T_light, const Rgb& T_wide, bool traced, const Rgb& R,
-                         const Rgb& mean_cos, const std::vector<double>& peak_moments, double theta2,
+                         const Rgb* mean_cos, const std::vector<double>& peak_moments, double theta2,
                          bool path_lengthening);
 
 // The estimators: radiance per unit sigma_s_i that medium i (split, peak fraction f) sends towards the

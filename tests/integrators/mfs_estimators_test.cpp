@@ -121,18 +121,23 @@ TEST(MfsEstimators, CameraPathAccumulatesDepthsAndSpread) {  // eqs. D2, D10
 TEST(MfsEstimators, PeakOnlyBeamDepths) {  // eqs. D8, D9
   const std::vector<double> chi_p = {1.0, 0.9, 0.75};
   const Rgb T_light(0.1, 0.2, 0.3), T_wide(0.5, 0.4, 0.3);
-  const LightBeam s = peak_only_beam(T_light, T_wide, false, Rgb(1.0), Rgb(1.0), chi_p, 0.05, false);
+  const LightBeam s = peak_only_beam(T_light, T_wide, false, Rgb(1.0), nullptr, chi_p, 0.05, false);
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(s.tau_ps[c], std::log(T_wide[c] / T_light[c]), 1e-15);
   EXPECT_EQ(s.T_wide, T_wide);
-  const LightBeam sl = peak_only_beam(T_light, T_wide, false, Rgb(1.0), Rgb(1.0), chi_p, 0.05, true);
+  const LightBeam sl = peak_only_beam(T_light, T_wide, false, Rgb(1.0), nullptr, chi_p, 0.05, true);
   EXPECT_NEAR(sl.T_wide[0], T_wide[0] * path_lengthening(0.05 * s.tau_ps[0], -std::log(T_wide[0])), 1e-15);
   // Traced: R multiplies T_wide; the mean cosine of a beam after tau is exp(-tau (1 - chi_1)) (eq. D3).
   const Rgb tau(0.0, 1.0, 7.0);
   const Rgb mean_cos(std::exp(-tau[0] * 0.1), std::exp(-tau[1] * 0.1), std::exp(-tau[2] * 0.1));
-  const LightBeam b = peak_only_beam(T_light, T_wide, true, Rgb(0.5), mean_cos, chi_p, 0.05, true);
+  const LightBeam b = peak_only_beam(T_light, T_wide, true, Rgb(0.5), &mean_cos, chi_p, 0.05, true);
+  // Traced without the mean cosine (beam_spread "straight"): R multiplies T_wide, the spread is D8's.
+  const Rgb R(0.5, 0.7, 0.9);
+  const LightBeam st = peak_only_beam(T_light, T_wide, true, R, nullptr, chi_p, 0.05, true);
   for (int c = 0; c < 3; ++c) {
     EXPECT_NEAR(b.tau_ps[c], tau[c], 1e-12);
     EXPECT_DOUBLE_EQ(b.T_wide[c], 0.5 * T_wide[c]);
+    EXPECT_EQ(st.tau_ps[c], s.tau_ps[c]);
+    EXPECT_DOUBLE_EQ(st.T_wide[c], R[c] * T_wide[c]);
   }
 }
 

@@ -445,7 +445,7 @@ TEST(Mfs, ThickPeakOnlyPathsMatchThePathTracerWithTheTracedBeam) {
   const Rgb ref = image_mean(pt.image);
   scene.integrator.type = "mfs";
   scene.integrator.spp = 4;
-  scene.integrator.options = {{"large_angle_scatters", 0}};
+  scene.integrator.options = {{"large_angle_scatters", 0}, {"beam_spread", "traced"}};
   const Rgb traced = image_mean(render(scene, RenderOptions{}).image);
   scene.integrator.options = {{"large_angle_scatters", 0}, {"beam_photons", 0}};
   const Rgb straight = image_mean(render(scene, RenderOptions{}).image);
@@ -476,9 +476,9 @@ TEST(Mfs, FirstWideScatterSeesTheBeamsSpread) {
   const Rgb ref = image_mean(render(scene, RenderOptions{}).image);
   scene.integrator.type = "mfs";
   scene.integrator.spp = 4;
-  scene.integrator.options = {{"large_angle_scatters", 1}};
+  scene.integrator.options = {{"large_angle_scatters", 1}, {"beam_spread", "traced"}};
   const Rgb blurred = image_mean(render(scene, RenderOptions{}).image);
-  scene.integrator.options = {{"large_angle_scatters", 1}, {"light_blur", false}};
+  scene.integrator.options = {{"large_angle_scatters", 1}, {"beam_spread", "traced"}, {"light_blur", false}};
   const Rgb collimated = image_mean(render(scene, RenderOptions{}).image);
   std::printf("at most one wide scatter: mfs %.5f (collimated beam %.5f) pathtrace %.5f\n", blurred[0],
               collimated[0], ref[0]);
@@ -613,8 +613,8 @@ TEST(Mfs, BeamGridSkipsIdleCellsWithoutChangingTheMedia) {
     TransmittanceGrid::build_pair(ctx.media, ctx.majorants, light, 32, 0.25, f, &full.emplace_back(),
                                   &reduced.emplace_back());
   const Vec3 cam(0.0, -6.0, 0.0);
-  const BeamGrid skip(ctx, splits, f, full, reduced, 4096, 40, 7, &cam, nullptr, true);
-  const BeamGrid all(ctx, splits, f, full, reduced, 4096, 40, 7, &cam, nullptr, false);
+  const BeamGrid skip(ctx, splits, f, full, reduced, 4096, 40, 7, true, &cam, nullptr, true);
+  const BeamGrid all(ctx, splits, f, full, reduced, 4096, 40, 7, true, &cam, nullptr, false);
   std::printf("beam grid: idle share of the cells %.3f\n", skip.idle_share());
   EXPECT_GT(skip.idle_share(), 0.2);
   EXPECT_EQ(all.idle_share(), 0.0);
@@ -664,6 +664,7 @@ TEST(Mfs, BeamGridSpreadFollowsTheStraightModelWithinACell) {
   MfsSettings ms = mfs_settings_from_json(nlohmann::json::object(), "test");
   ms.large_angle_scatters = 0;
   ms.beam_photons = 1 << 17;
+  ms.beam_spread = BeamSpread::traced;
   ms.scatter_grid_resolution = 16;
   const MfsIntegrator mfs(ctx, ms);
   ASSERT_NE(mfs.beam_grid(), nullptr);
@@ -751,7 +752,7 @@ TEST(Mfs, BeamGridKeepsOneChannelForGreyMediaAndGreyLights) {
     for (const Light& light : ctx.lights)
       TransmittanceGrid::build_pair(ctx.media, ctx.majorants, light, 32, 0.25, f, &full.emplace_back(),
                                     &reduced.emplace_back());
-    return BeamGrid(ctx, splits, f, full, reduced, 4096, 24, 7, camera ? &cam : nullptr);
+    return BeamGrid(ctx, splits, f, full, reduced, 4096, 24, 7, true, camera ? &cam : nullptr);
   };
   EXPECT_EQ(grid(chromatic, false).channels(), 3);
   for (const bool camera : {false, true}) {

@@ -94,7 +94,8 @@ TEST(Registry, DefaultsAreWrittenOut) {
   EXPECT_EQ(mfs["photon_splat"], "trilinear");
   EXPECT_EQ(mfs["camera_tilt"], true);
   EXPECT_EQ(mfs["exact_light_transmittance"], "auto");
-  EXPECT_EQ(mfs.size(), 22u);  // every option of the table in mfs.h
+  EXPECT_EQ(mfs["beam_spread"], "straight");
+  EXPECT_EQ(mfs.size(), 23u);  // every option of the table in mfs.h
 }
 
 TEST(Registry, UnknownFieldsAndNamesAreErrors) {
