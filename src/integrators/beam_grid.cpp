@@ -162,6 +162,8 @@ struct BeamPhotons {
   const MajorantGrid* majorants;     // the photons' tracking majorants (null: the scene's)
   const std::vector<uint8_t>& idle;  // per cell of the node grid: see idle_cells
 
+  // T_light and T_wide from q to the light by the chord in closed form (1 where it has none).
+  void chord_to_light(const Vec3& q, Rgb* full, Rgb* reduced) const;
   // T_wide from q to the light: the map, or the chord.
   Rgb wide(const Vec3& q) const;
   // The straight model's spread 1 - mean cosine at q, 1 - exp(-tau (1 - chi_1)) for the peak depth tau =
@@ -174,28 +176,27 @@ struct BeamPhotons {
   bool scatter(const Vec3& xc, Vec3* w, BeamWalk& walk, Rng& rng, PhotonBatch& batch) const;
 };
 
+void BeamPhotons::chord_to_light(const Vec3& q, Rgb* full, Rgb* reduced) const {
+  const double inf = std::numeric_limits<double>::infinity();
+  const bool done = point
+                        ? chord_full_and_reduced(ctx, q, normalize(point->position - q),
+                                                 (point->position - q).length(), peak_fraction, full, reduced)
+                        : chord_full_and_reduced(ctx, q, -dir_w, inf, peak_fraction, full, reduced);
+  NIMBUS_DCHECK(done);
+  if (!done) *full = *reduced = Rgb(1.0);
+}
+
 Rgb BeamPhotons::wide(const Vec3& q) const {
   if (!chord) return T_wide.lookup(q);
   Rgb full, reduced;
-  const double inf = std::numeric_limits<double>::infinity();
-  const bool done =
-      point ? chord_full_and_reduced(ctx, q, normalize(point->position - q), (point->position - q).length(),
-                                     peak_fraction, &full, &reduced)
-            : chord_full_and_reduced(ctx, q, -dir_w, inf, peak_fraction, &full, &reduced);
-  NIMBUS_DCHECK(done);
-  return done ? reduced : Rgb(1.0);
+  chord_to_light(q, &full, &reduced);
+  return reduced;
 }
 
 Rgb BeamPhotons::straight_spread(const Vec3& q, Rgb* tw) const {
   Rgb full, reduced;
   if (chord) {
-    const double inf = std::numeric_limits<double>::infinity();
-    const bool done =
-        point ? chord_full_and_reduced(ctx, q, normalize(point->position - q), (point->position - q).length(),
-                                       peak_fraction, &full, &reduced)
-              : chord_full_and_reduced(ctx, q, -dir_w, inf, peak_fraction, &full, &reduced);
-    NIMBUS_DCHECK(done);
-    if (!done) full = reduced = Rgb(1.0);
+    chord_to_light(q, &full, &reduced);
   } else {
     const TrilinearStencil st = T_wide.stencil(q);  // the pair's shared layout (build_pair)
     reduced = T_wide.lookup(st);
