@@ -216,6 +216,39 @@ void fold_node(const std::vector<SourceBlock>& blocks, size_t rgb_size, int coef
   }
 }
 
+// The colour (max channel 1) every source's photons carry, where every source has a single-colour
+// block and all have the same colour; none otherwise.
+std::optional<Rgb> common_colour(const std::vector<SourceBlock>& blocks, size_t rgb_size) {
+  if (rgb_size > 0 || blocks.empty()) return std::nullopt;
+  for (const SourceBlock& b : blocks)
+    if (b.offset < 0 || !(b.colour == blocks[0].colour)) return std::nullopt;
+  return blocks[0].colour;
+}
+
+// fold_node for a one-channel grid (common_colour): the single-colour blocks' sum, coeffs per node.
+void fold_node_mono(const std::vector<SourceBlock>& blocks, int coeffs, const float* tally, size_t n,
+                    double wt, double* acc) {
+  for (const SourceBlock& b : blocks) {
+    const float* t = tally + b.offset + n * coeffs;
+    for (int h = 0; h < coeffs; ++h) acc[h] += wt * t[h];
+  }
+}
+
+// How the batches' tallies fold into the grid's nodes of `channels` (1: common_colour's) x coeffs floats.
+TallyFold tally_fold(const std::vector<SourceBlock>& blocks, size_t rgb_size, int coeffs, size_t nodes,
+                     int channels) {
+  TallyFold fold;
+  fold.nodes = nodes;
+  fold.out_floats = channels * coeffs;
+  fold.fold = [&blocks, rgb_size, coeffs, channels](const float* tally, size_t n, double wt, double* acc) {
+    if (channels == 1)
+      fold_node_mono(blocks, coeffs, tally, n, wt, acc);
+    else
+      fold_node(blocks, rgb_size, coeffs, tally, n, wt, acc);
+  };
+  return fold;
+}
+
 // A photon of chromatic media traced once for all three channels (hero-channel sampling, the balance
 // heuristic over channels: Veach's multi-sample MIS with one technique per channel). Photon i of a
 // source's n is driven by hero channel c = i mod 3 (a_c = n_c / n of them): delta tracking with real
@@ -602,7 +635,7 @@ ScatterGrid::ScatterGrid(const SceneContext& ctx, const std::vector<const PhaseS
     : bands_(std::clamp(s.bands, 1, kShMaxBands)), coeffs_(bands_ * bands_), photons_(s.photons) {
   const Bounds media_bounds = ctx.media.bounds();
   if (media_bounds.empty()) {
-    values_.assign(grid_.size() * 3 * coeffs_, 0.0f);  // the default grid: 2^3 nodes over [0, 1]^3
+    values_.assign(grid_.size() * channels_ * coeffs_, 0.0f);  // the default grid: 2^3 nodes over [0, 1]^3
     return;
   }
   grid_ = node_grid_padded(media_bounds, s.resolution > 0 ? s.resolution : 32);
@@ -611,7 +644,7 @@ ScatterGrid::ScatterGrid(const SceneContext& ctx, const std::vector<const PhaseS
     trace(ctx, splits, peak_fraction, s);
   // No photons: zero. (Not filled before tracing: the photons' sum replaces values_, and a zero-fill of
   // the 10 MB grid was a measurable part of the set-up's page faults; issue 12.)
-  if (values_.empty()) values_.assign(grid_.size() * 3 * coeffs_, 0.0f);
+  if (values_.empty()) values_.assign(grid_.size() * channels_ * coeffs_, 0.0f);
 }
 
 void ScatterGrid::trace(const SceneContext& ctx, const std::vector<const PhaseSplit*>& splits,
@@ -663,12 +696,12 @@ void ScatterGrid::trace(const SceneContext& ctx, const std::vector<const PhaseSp
   if (wants_pilot(s)) photons_ = adaptive_photon_count(s, pilot_collisions(photons, tally_size));
   photons.split(photons_);
   const size_t total = size_t(passes) * photons.first.back();
-  TallyFold fold;
-  fold.nodes = grid_.size();
-  fold.out_floats = 3 * coeffs_;
-  fold.fold = [&](const float* tally, size_t n, double wt, double* acc) {
-    fold_node(photons.blocks, rgb_size, coeffs_, tally, n, wt, acc);
-  };
+  // Every source of one colour (grey media lit by lights of one tint): one channel per node, the tint
+  // kept aside (evaluate multiplies it back in).
+  const std::optional<Rgb> tint = common_colour(photons.blocks, rgb_size);
+  channels_ = tint ? 1 : 3;
+  tint_ = tint.value_or(Rgb(1.0));
+  const TallyFold fold = tally_fold(photons.blocks, rgb_size, coeffs_, grid_.size(), channels_);
   // The batches' sums divided by the node volume: fluence and flux.
   values_ = trace_photons_folded(
       total, s.seed ^ 0x6d756c7469706c65ull, tally_size, 1.0 / grid_.cell_volume(), fold,
@@ -679,7 +712,7 @@ void ScatterGrid::trace(const SceneContext& ctx, const std::vector<const PhaseSp
 void ScatterGrid::build_mips() {
   // Each level halves the node count along every axis (nodes 2j of the level below), with the tent
   // filter (1/4, 1/2, 1/4) per axis; nodes beyond the level below's last are clamped to it.
-  const int floats = 3 * coeffs_;
+  const int floats = channels_ * coeffs_;
   const NodeGrid* below = &grid_;
   const float* src = values_.data();
   while (std::max({below->nodes[0], below->nodes[1], below->nodes[2]}) > 4 && mips_.size() < 4) {
@@ -703,8 +736,9 @@ void ScatterGrid::accumulate(int level, const Vec3& p, double wt, double* L) con
 }
 
 void ScatterGrid::accumulate(const TrilinearStencil& st, const float* v, double wt, double* L) const {
-  const int floats = 3 * coeffs_;
-  // The same sums with the node's size known at compile time for the default 3 bands (27 floats).
+  const int floats = channels_ * coeffs_;
+  // The same sums with the node's size known at compile time for the default 3 bands (27 floats, or 9
+  // for a one-channel grid).
   const auto sum = [&](auto n) {
     for (int k = 0; k < 8; ++k) {
       const float* node = &v[st.node[k] * size_t(n())];
@@ -714,6 +748,8 @@ void ScatterGrid::accumulate(const TrilinearStencil& st, const float* v, double 
   };
   if (floats == 27)
     sum([] { return 27; });
+  else if (floats == 9)
+    sum([] { return 9; });
   else
     sum([floats] { return floats; });
 }
@@ -723,10 +759,11 @@ Rgb ScatterGrid::evaluate(const double* L, const ShBasis& y_out,
   const double* y = y_out.y;
   Rgb r;
   for (int c = 0; c < 3; ++c) {
+    const double* Lc = L + (channels_ == 1 ? 0 : coeffs_ * c);
     double v = 0.0;
     for (int l = 0; l < bands_; ++l)
-      for (int h = l * l; h < (l + 1) * (l + 1); ++h) v += chi[l][c] * L[coeffs_ * c + h] * y[h];
-    r[c] = std::max(0.0, v);
+      for (int h = l * l; h < (l + 1) * (l + 1); ++h) v += chi[l][c] * Lc[h] * y[h];
+    r[c] = std::max(0.0, tint_[c] * v);
   }
   return r;
 }

@@ -131,7 +131,12 @@ class ScatterGrid {
   int bands_ = 3, coeffs_ = 9;
   int photons_ = 0;
   uint64_t rejection_failures_ = 0;
-  FloatArray values_;  // per node: channel c at [coeffs c + h]: L_lm, h = l^2 + l + m
+  // Channels per node: 1 where every source's photons carry one colour (tint_, max channel 1; grey
+  // media lit by lights of one tint), else 3.
+  int channels_ = 3;
+  Rgb tint_{1.0};
+  FloatArray values_;  // per node: channel c at [coeffs c + h]: L_lm, h = l^2 + l + m (c = 0 only if
+                       // channels_ is 1: the moments in units of tint_)
   struct Level {
     NodeGrid grid;  // nodes at grid_.bounds.lo + j spacing (may overhang grid_.bounds)
     FloatArray values;

@@ -840,7 +840,6 @@ TEST(Mfs, FilteredLookupsOfTheScatterGrid) {
   std::array<Rgb, kShMaxBands> chi;
   for (int l = 0; l < kShMaxBands; ++l) chi[l] = Rgb(std::pow(0.5, l));
   Rng rng(5, 0);
-  double worst = 0.0;
   for (int i = 0; i < 100; ++i) {
     const Vec3 p(1.6 * rng.uniform() - 0.8, 1.6 * rng.uniform() - 0.8, 1.6 * rng.uniform() - 0.8);
     const Vec3 w = normalize(Vec3(rng.uniform() - 0.5, rng.uniform() - 0.5, rng.uniform() - 0.5));

@@ -191,5 +191,53 @@ TEST(ScatterGrid, PhotonsOverAnalyticPiecesKeepTheMean) {
   }
 }
 
+// Grey media lit by sources of one colour keep one channel per node (the moments in units of the
+// colour, which the lookup multiplies back in): a sun of colour (1, 0.5, 0.25) gives, channel by
+// channel, that colour times the grid of a white sun of the same strength (the same photons: the
+// strongest channel sets their power), in a third of the memory of a grid whose sun and sky differ in
+// colour.
+TEST(ScatterGrid, OneColourOfLightKeepsOneChannel) {
+  const auto grid_of = [](const std::string& lights) {
+    return test::scene_from_json("{" + test::camera_json(8, 8, 40.0) + R"(,
+      "media": [{"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1}, "sigma_s": 4.0, "sigma_a": 0.1,
+                 "phase": {"type": "hg", "g": 0.8}}], "lights": [)" +
+                                 lights + "]}");
+  };
+  const Scene white = grid_of(R"({"type": "directional", "direction": [-1, 0.3, 0.2], "irradiance": 3.0})");
+  const Scene tinted =
+      grid_of(R"({"type": "directional", "direction": [-1, 0.3, 0.2], "irradiance": [3.0, 1.5, 0.75]})");
+  const Scene mixed =
+      grid_of(R"({"type": "directional", "direction": [-1, 0.3, 0.2], "irradiance": [3.0, 1.5, 0.75]},
+                                 {"type": "environment", "radiance": 0.03})");
+  std::vector<std::unique_ptr<SceneContext>> ctx;
+  std::vector<std::unique_ptr<ScatterGrid>> grids;
+  const Phase& phase = white.media.front().phase;
+  const PhaseSplit split(phase, auto_peak_fraction(phase));
+  ScatterGridSettings s;
+  s.photons = 2048;
+  s.resolution = 12;
+  s.prefiltered = false;
+  for (const Scene* scene : {&white, &tinted, &mixed}) {
+    ctx.push_back(std::make_unique<SceneContext>(*scene));
+    grids.push_back(std::make_unique<ScatterGrid>(*ctx.back(), std::vector<const PhaseSplit*>{&split},
+                                                  std::vector<double>{split.f()}, s));
+  }
+  EXPECT_EQ(3 * grids[0]->memory_bytes(), grids[2]->memory_bytes());
+  EXPECT_EQ(grids[0]->memory_bytes(), grids[1]->memory_bytes());
+  std::array<Rgb, kShMaxBands> chi;
+  for (int l = 0; l < kShMaxBands; ++l) chi[l] = Rgb(std::pow(0.5, l), std::pow(0.6, l), std::pow(0.7, l));
+  const Rgb tint(1.0, 0.5, 0.25);
+  Rng rng(5, 0);
+  int lit = 0;
+  for (int i = 0; i < 200; ++i) {
+    const Vec3 p(1.4 * rng.uniform() - 0.7, 1.4 * rng.uniform() - 0.7, 1.4 * rng.uniform() - 0.7);
+    const Vec3 w = normalize(Vec3(rng.uniform() - 0.5, rng.uniform() - 0.5, rng.uniform() - 0.5));
+    const Rgb a = grids[0]->scattered(p, w, chi), b = grids[1]->scattered(p, w, chi);
+    lit += a[0] > 0.0;
+    for (int c = 0; c < 3; ++c) ASSERT_EQ(b[c], tint[c] * a[c]) << i << " " << c;
+  }
+  EXPECT_GT(lit, 100);
+}
+
 }  // namespace
 }  // namespace nimbus
