@@ -53,8 +53,8 @@ void marched_full_and_reduced(const SceneContext& ctx, const Vec3& p, const Vec3
     tau_reduced += reduced * dt;
     return min_component(tau_reduced) < 50.0;
   });
-  *T_full = exp(-tau);
-  *T_reduced = exp(-tau_reduced);
+  *T_full = exp_channels(-tau);
+  *T_reduced = exp_channels(-tau_reduced);
 }
 
 bool chord_full_and_reduced(const SceneContext& ctx, const Vec3& p, const Vec3& w, double tmax,
@@ -69,8 +69,8 @@ bool chord_full_and_reduced(const SceneContext& ctx, const Vec3& p, const Vec3& 
   ctx.media.eval(p + w * (0.5 * (t0 + t1)), &m);
   const Rgb sigma_t = m.sigma_t();
   const Rgb sigma_red = peak_fraction.empty() ? sigma_t : sigma_t - m.sigma_s_i[0] * peak_fraction[0];
-  *T_full = exp(-sigma_t * (t1 - t0));
-  *T_reduced = exp(-sigma_red * (t1 - t0));
+  *T_full = exp_channels(-sigma_t * (t1 - t0));
+  *T_reduced = exp_channels(-sigma_red * (t1 - t0));
   return true;
 }
 

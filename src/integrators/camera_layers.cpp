@@ -36,7 +36,7 @@ void march_depth(const SceneMedia& media, const MajorantGrid& grid, const Vec3& 
   MediumPoint mp;
   march(grid, o, d, tmax, tau_step, 0.5, [&](const Vec3& p, double t, double dt) {
     media.eval(p, &mp);
-    const Rgb T1 = T * exp(-mp.sigma_t() * dt);
+    const Rgb T1 = T * exp_channels(-mp.sigma_t() * dt);
     if (average(T1) < 0.5) {
       sample->depth = t - 0.5 * dt + dt * half_transmittance_fraction(T, T1);
       sample->albedo = scattering_albedo(mp);

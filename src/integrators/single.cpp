@@ -69,11 +69,11 @@ Rgb SingleScatter::trace(const Ray& ray, Rng& rng, CameraSample* sample, int bou
   MarchRecorder layers(sample);  // depth, albedo and deep segments when the film asks
   march(ctx_.majorants, o, d, hit.t, s_.tau_step, jitter, [&](const Vec3& p, double t, double dt) {
     ctx_.media.eval(p, &mp);
-    const Rgb step_T = exp(-mp.sigma_t() * dt);
+    const Rgb step_T = exp_channels(-mp.sigma_t() * dt);
     Rgb L_step = ctx_.media.emits() ? emission_over_step(mp.emission, T, T * step_T, dt) : Rgb(0.0);
     if (max_component(mp.sigma_s) > 0.0) {
       // Camera-side transmittance to the sample point, then single scattering towards the lights.
-      const Rgb T_here = T * exp(-mp.sigma_t() * (jitter * dt));
+      const Rgb T_here = T * exp_channels(-mp.sigma_t() * (jitter * dt));
       Rgb in_scatter(0.0);
       for (int i = 0; i < mp.count; ++i) {
         if (max_component(mp.sigma_s_i[i]) <= 0.0) continue;

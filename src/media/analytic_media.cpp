@@ -59,7 +59,7 @@ Rgb AnalyticMedia::transmittance(const Vec3& o, const Vec3& d, double tmax) cons
     double t0, t1;
     if (chord(i, o, d, tmax, &t0, &t1)) tau += media_[i].sigma_t * (t1 - t0);
   }
-  return exp(-tau);
+  return exp_channels(-tau);
 }
 
 }  // namespace nimbus
