@@ -53,6 +53,7 @@ MfsSettings mfs_settings_from_json(const nlohmann::json& options, const std::str
   s.filtered_lookups = o.boolean("filtered_lookups", s.filtered_lookups);
   s.source_blur = o.boolean("source_blur", s.source_blur);
   s.camera_tilt = o.boolean("camera_tilt", s.camera_tilt);
+  s.camera_shift = o.boolean("camera_shift", s.camera_shift);
   s.peak_toward_camera = o.boolean("peak_toward_camera", s.peak_toward_camera);
   if (bool b = false; o.keyword_or_boolean("exact_light_transmittance", "auto", &b))
     s.exact_light_transmittance = b;
@@ -86,6 +87,7 @@ nlohmann::json to_json(const MfsSettings& s) {
                       {"filtered_lookups", s.filtered_lookups},
                       {"source_blur", s.source_blur},
                       {"camera_tilt", s.camera_tilt},
+                      {"camera_shift", s.camera_shift},
                       {"peak_toward_camera", s.peak_toward_camera},
                       {"shadow_map_resolution", s.shadow_map_resolution}};
   j["peak_fraction"] = s.peak_fraction ? nlohmann::json(*s.peak_fraction) : nlohmann::json("auto");
@@ -354,11 +356,17 @@ MfsIntegrator::Sources MfsIntegrator::step_sources(const MediumPoint& m, const V
   } else if (s_.source_blur) {
     add_sources(m, p, d, d, y_out, t, y, cam, rng, false, true, &src);
     add_blurred_sources(p, d, y_out, t, y, cam, rng, &src);
-  } else if (Vec3 d_s; probe && tilt(p, d, t, cam, *probe, &d_s, &residual)) {
+  } else if (Vec3 d_s, shift(0.0); probe && tilt(p, d, t, cam, *probe, &d_s, &residual, &shift)) {
     CameraPoint y_s = y;  // the scattered light: the tilted direction and the residual spread
     y_s.tau_p = y.tau_p * residual;
     const ShBasis y_out_s(-d_s, grid_ ? grid_->bands() : 1);
-    add_sources(m, p, d, d_s, y_out_s, t, y_s, cam, rng, true, true, &src);
+    if (shift == Vec3(0.0)) {
+      add_sources(m, p, d, d_s, y_out_s, t, y_s, cam, rng, true, true, &src);
+    } else {
+      MediumPoint ms;
+      ctx_.media.eval(p + shift, &ms);
+      add_shifted_sources(m, ms, p, p + shift, d, d_s, y_out, y_out_s, t, y, y_s, cam, rng, &src);
+    }
   } else {
     add_sources(m, p, d, d, y_out, t, y, cam, rng, true, true, &src);
   }
@@ -372,11 +380,16 @@ std::optional<FootprintProbe> MfsIntegrator::footprint_probe(const Vec3& d, Rng&
 }
 
 bool MfsIntegrator::tilt(const Vec3& p, const Vec3& d, double t, const CameraPath& cam, FootprintProbe& probe,
-                         Vec3* d_s, double* residual) const {
+                         Vec3* d_s, double* residual, Vec3* shift) const {
   const double sigma = cam.lateral_spread(t);
   if (!(sigma > 0.0)) return false;
   const Vec3 u = probe.next(sigma);
   const bool plus = ctx_.media.inside(p + u), minus = ctx_.media.inside(p - u);
+  if (plus && minus && s_.camera_shift) {  // eq. D17: the source at the offset, in its direction
+    *shift = u;
+    *d_s = survivor_direction(cam, t, d, u, residual);
+    return true;
+  }
   if (plus == minus) return false;
   *d_s = survivor_direction(cam, t, d, plus ? u : -u, residual);
   return true;
@@ -392,6 +405,27 @@ void MfsIntegrator::add_blurred_sources(const Vec3& p, const Vec3& d, const ShBa
   MediumPoint m;
   ctx_.media.eval(ps, &m);
   add_sources(m, ps, d, d, y_out, t, y, cam, rng, true, false, out);
+}
+
+void MfsIntegrator::add_shifted_sources(const MediumPoint& m, const MediumPoint& ms, const Vec3& p,
+                                        const Vec3& ps, const Vec3& d, const Vec3& d_s, const ShBasis& y_out,
+                                        const ShBasis& y_out_s, double t, const CameraPoint& y,
+                                        const CameraPoint& y_s, const CameraPath& cam, Rng& rng,
+                                        Sources* out) const {
+  std::optional<TrilinearStencil> st;
+  if (shared_stencil_) st = grid_->node_grid().stencil(p);
+  for (int i = 0; i < m.count; ++i) {
+    if (max_component(m.sigma_s_i[i]) > 0.0) {  // at p: the forward peak and the grid's light
+      const MediumRadiance on = medium_radiance(i, p, d, d, y_out, t, y, cam, rng, st ? &*st : nullptr);
+      out->in_scatter += m.sigma_s_i[i] * (on.L - on.L_lights);
+      out->peak_scatter += m.sigma_s_i[i] * on.L_peak;
+    }
+    if (max_component(ms.sigma_s_i[i]) > 0.0) {  // at ps: the lights' first wide scatter
+      const MediumRadiance off = medium_radiance(i, ps, d, d_s, y_out_s, t, y_s, cam, rng, nullptr, false);
+      out->in_scatter += ms.sigma_s_i[i] * off.L_lights;
+      out->lights_scatter += ms.sigma_s_i[i] * off.L_lights;
+    }
+  }
 }
 
 void MfsIntegrator::add_sources(const MediumPoint& m, const Vec3& p, const Vec3& d, const Vec3& d_s,
@@ -411,7 +445,8 @@ void MfsIntegrator::add_sources(const MediumPoint& m, const Vec3& p, const Vec3&
 MfsIntegrator::MediumRadiance MfsIntegrator::medium_radiance(int i, const Vec3& p, const Vec3& d,
                                                              const Vec3& d_s, const ShBasis& y_out, double t,
                                                              const CameraPoint& y, const CameraPath& cam,
-                                                             Rng& rng, const TrilinearStencil* st) const {
+                                                             Rng& rng, const TrilinearStencil* st,
+                                                             bool with_grid) const {
   const PhaseSplit& split = *splits_[i];
   const double f = f_[i];
   MediumRadiance out{Rgb(0.0), Rgb(0.0), Rgb(0.0)};
@@ -463,7 +498,7 @@ MfsIntegrator::MediumRadiance MfsIntegrator::medium_radiance(int i, const Vec3& 
   }
   // Add the light that already took wide scatters (and the environment's): its last wide scatter is at y.
   out.L_lights = out.L;
-  if (grid_) out.L += higher_orders(i, p, y_out, t, y.tau_p, cam, st);
+  if (grid_ && with_grid) out.L += higher_orders(i, p, y_out, t, y.tau_p, cam, st);
   return out;
 }
 

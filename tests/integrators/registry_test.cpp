@@ -76,6 +76,7 @@ TEST(Registry, SettingsRoundTripThroughJson) {
                                               {"filtered_lookups", true},
                                               {"source_blur", true},
                                               {"camera_tilt", false},
+                                              {"camera_shift", true},
                                               {"peak_toward_camera", true},
                                               {"exact_light_transmittance", true},
                                               {"shadow_map_resolution", 32}});
@@ -93,9 +94,10 @@ TEST(Registry, DefaultsAreWrittenOut) {
   EXPECT_EQ(mfs["light_path"], "forward");
   EXPECT_EQ(mfs["photon_splat"], "trilinear");
   EXPECT_EQ(mfs["camera_tilt"], true);
+  EXPECT_EQ(mfs["camera_shift"], false);
   EXPECT_EQ(mfs["exact_light_transmittance"], "auto");
   EXPECT_EQ(mfs["beam_spread"], "straight");
-  EXPECT_EQ(mfs.size(), 23u);  // every option of the table in mfs.h
+  EXPECT_EQ(mfs.size(), 24u);  // every option of the table in mfs.h
 }
 
 TEST(Registry, UnknownFieldsAndNamesAreErrors) {
