@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <limits>
 #include <optional>
 
@@ -351,21 +352,22 @@ MfsIntegrator::Sources MfsIntegrator::step_sources(const MediumPoint& m, const V
                                                    FootprintProbe* probe) const {
   Sources src;
   double residual = 1.0;
+  bool bulk = false;
   if (s_.light_side()) {  // forward_side "light" has no camera-side spread
     add_sources(m, p, d, d, y_out, t, y, cam, rng, true, true, &src);
   } else if (s_.source_blur) {
     add_sources(m, p, d, d, y_out, t, y, cam, rng, false, true, &src);
     add_blurred_sources(p, d, y_out, t, y, cam, rng, &src);
-  } else if (Vec3 d_s, shift(0.0); probe && tilt(p, d, t, cam, *probe, &d_s, &residual, &shift)) {
-    CameraPoint y_s = y;  // the scattered light: the tilted direction and the residual spread
-    y_s.tau_p = y.tau_p * residual;
-    const ShBasis y_out_s(-d_s, grid_ ? grid_->bands() : 1);
-    if (shift == Vec3(0.0)) {
-      add_sources(m, p, d, d_s, y_out_s, t, y_s, cam, rng, true, true, &src);
+  } else if (Vec3 d_s; probe && tilt(p, d, t, cam, *probe, &d_s, &residual, &bulk)) {
+    if (bulk) {  // eq. D17: the lights' first wide scatter tilted along their beams' gradients
+      CameraPoint y_g = y;
+      y_g.gradient_tilt = cam.offset_deflection_covariance(t) * y.sigma_red;
+      add_sources(m, p, d, d, y_out, t, y_g, cam, rng, true, true, &src);
     } else {
-      MediumPoint ms;
-      ctx_.media.eval(p + shift, &ms);
-      add_shifted_sources(m, ms, p, p + shift, d, d_s, y_out, y_out_s, t, y, y_s, cam, rng, &src);
+      CameraPoint y_s = y;  // the scattered light: the tilted direction and the residual spread
+      y_s.tau_p = y.tau_p * residual;
+      const ShBasis y_out_s(-d_s, grid_ ? grid_->bands() : 1);
+      add_sources(m, p, d, d_s, y_out_s, t, y_s, cam, rng, true, true, &src);
     }
   } else {
     add_sources(m, p, d, d, y_out, t, y, cam, rng, true, true, &src);
@@ -380,14 +382,13 @@ std::optional<FootprintProbe> MfsIntegrator::footprint_probe(const Vec3& d, Rng&
 }
 
 bool MfsIntegrator::tilt(const Vec3& p, const Vec3& d, double t, const CameraPath& cam, FootprintProbe& probe,
-                         Vec3* d_s, double* residual, Vec3* shift) const {
+                         Vec3* d_s, double* residual, bool* bulk) const {
   const double sigma = cam.lateral_spread(t);
   if (!(sigma > 0.0)) return false;
   const Vec3 u = probe.next(sigma);
   const bool plus = ctx_.media.inside(p + u), minus = ctx_.media.inside(p - u);
-  if (plus && minus && s_.camera_shift) {  // eq. D17: the source at the offset, in its direction
-    *shift = u;
-    *d_s = survivor_direction(cam, t, d, u, residual);
+  if (plus && minus && s_.camera_shift) {  // eq. D17: the bulk
+    *bulk = true;
     return true;
   }
   if (plus == minus) return false;
@@ -407,27 +408,6 @@ void MfsIntegrator::add_blurred_sources(const Vec3& p, const Vec3& d, const ShBa
   add_sources(m, ps, d, d, y_out, t, y, cam, rng, true, false, out);
 }
 
-void MfsIntegrator::add_shifted_sources(const MediumPoint& m, const MediumPoint& ms, const Vec3& p,
-                                        const Vec3& ps, const Vec3& d, const Vec3& d_s, const ShBasis& y_out,
-                                        const ShBasis& y_out_s, double t, const CameraPoint& y,
-                                        const CameraPoint& y_s, const CameraPath& cam, Rng& rng,
-                                        Sources* out) const {
-  std::optional<TrilinearStencil> st;
-  if (shared_stencil_) st = grid_->node_grid().stencil(p);
-  for (int i = 0; i < m.count; ++i) {
-    if (max_component(m.sigma_s_i[i]) > 0.0) {  // at p: the forward peak and the grid's light
-      const MediumRadiance on = medium_radiance(i, p, d, d, y_out, t, y, cam, rng, st ? &*st : nullptr);
-      out->in_scatter += m.sigma_s_i[i] * (on.L - on.L_lights);
-      out->peak_scatter += m.sigma_s_i[i] * on.L_peak;
-    }
-    if (max_component(ms.sigma_s_i[i]) > 0.0) {  // at ps: the lights' first wide scatter
-      const MediumRadiance off = medium_radiance(i, ps, d, d_s, y_out_s, t, y_s, cam, rng, nullptr, false);
-      out->in_scatter += ms.sigma_s_i[i] * off.L_lights;
-      out->lights_scatter += ms.sigma_s_i[i] * off.L_lights;
-    }
-  }
-}
-
 void MfsIntegrator::add_sources(const MediumPoint& m, const Vec3& p, const Vec3& d, const Vec3& d_s,
                                 const ShBasis& y_out, double t, const CameraPoint& y, const CameraPath& cam,
                                 Rng& rng, bool scattered, bool peak, Sources* out) const {
@@ -445,8 +425,7 @@ void MfsIntegrator::add_sources(const MediumPoint& m, const Vec3& p, const Vec3&
 MfsIntegrator::MediumRadiance MfsIntegrator::medium_radiance(int i, const Vec3& p, const Vec3& d,
                                                              const Vec3& d_s, const ShBasis& y_out, double t,
                                                              const CameraPoint& y, const CameraPath& cam,
-                                                             Rng& rng, const TrilinearStencil* st,
-                                                             bool with_grid) const {
+                                                             Rng& rng, const TrilinearStencil* st) const {
   const PhaseSplit& split = *splits_[i];
   const double f = f_[i];
   MediumRadiance out{Rgb(0.0), Rgb(0.0), Rgb(0.0)};
@@ -463,9 +442,12 @@ MfsIntegrator::MediumRadiance MfsIntegrator::medium_radiance(int i, const Vec3& 
       out.L += light_side_scatter(ls.weight, f, split, mu, beam.tau_ps, beam.T_wide);  // eq. D11
       return;
     }
-    const PhaseSplit::Angle a = PhaseSplit::angle(mu);                              // once for both terms
-    const PhaseSplit::Angle a_s = tilted ? PhaseSplit::angle(dot(d_s, ls.wi)) : a;  // the scattered light's
-    if (s_.large_angle_scatters != 0)                                               // eq. D7, first term
+    const PhaseSplit::Angle a = PhaseSplit::angle(mu);  // once for both terms
+    const PhaseSplit::Angle a_s =  // the scattered light's: camera_tilt's (D16) or camera_shift's (D17)
+        y.gradient_tilt > 0.0 ? PhaseSplit::angle(dot(gradient_tilted(d_s, ls.wi, y.gradient_tilt), ls.wi))
+        : tilted              ? PhaseSplit::angle(dot(d_s, ls.wi))
+                              : a;
+    if (s_.large_angle_scatters != 0)  // eq. D7, first term
       out.L += first_wide_scatter(ls.weight, f, split, a_s, y.tau_p, s_.light_blur ? beam.tau_ps : Rgb(0.0),
                                   beam.T_wide);
     if (s_.forward_light_path() && beam.toward && camera_ray())  // the traced beam's P_peak to the camera
@@ -498,7 +480,7 @@ MfsIntegrator::MediumRadiance MfsIntegrator::medium_radiance(int i, const Vec3& 
   }
   // Add the light that already took wide scatters (and the environment's): its last wide scatter is at y.
   out.L_lights = out.L;
-  if (grid_ && with_grid) out.L += higher_orders(i, p, y_out, t, y.tau_p, cam, st);
+  if (grid_) out.L += higher_orders(i, p, y_out, t, y.tau_p, cam, st);
   return out;
 }
 

@@ -20,7 +20,7 @@
 //    spread (D10).
 // Near a medium's side the scattered light's direction is tilted towards the medium, as the camera-side
 // peak-scattered paths that stay in it are (camera_tilt, D16); optionally, in the bulk, the lights' first
-// wide scatter is read at a point of the footprint, in the direction tilted with it (camera_shift, D17).
+// wide scatter is read in the direction tilted along the beam's gradient (camera_shift, D17).
 // Camera-side light is attenuated by the reduced extinction (times the 1 / cosh path lengthening, D5,
 // with path_lengthening). forward_side "light" (D11) instead spreads everything on the light's side and
 // takes the camera leg exactly. Light transmittances come from deep shadow maps (deterministic); the
@@ -52,7 +52,7 @@
 // | `filtered_lookups`        | boolean                       | false     | scatter grid read pre-filtered over the camera-side lateral spread |
 // | `source_blur`             | boolean                       | false     | the source (sigma_s times every scattered term) read at a point drawn from the camera-side lateral footprint (D10), so rays near a boundary gather partly outside the medium |
 // | `camera_tilt`             | boolean                       | true      | near a medium's side, the camera-bound light's direction is tilted towards the medium, as the peak-scattered paths that stayed in it are (D16; ignored with source_blur, forward_side "light" and light_path "beer_lambert") |
-// | `camera_shift`            | boolean                       | false     | where the whole footprint pair is in the medium, the lights' first wide scatter read at a footprint point, in the direction tilted with it (the offset's and the deflection's correlation, D17; with camera_tilt only) |
+// | `camera_shift`            | boolean                       | false     | in the bulk (both footprint points in a medium), the lights' first wide scatter read in the direction tilted towards each light by cov(offset, deflection) sigma_red: the correlation of the footprint's offset with its deflection along the beam's gradient (D17; with camera_tilt only) |
 // | `peak_toward_camera`      | boolean                       | false     | the forward peak alone takes its angular factor from the beam grid's photons (their P_peak towards the camera) instead of peak_eff at the beam's mean-cosine depth (one medium only) |
 // | `exact_light_transmittance` | "auto" or boolean           | "auto"    | T_light and T_wide to directional and point lights without the shadow maps: the chord in closed form for one constant-density sphere or box, else a march ("auto": true for one constant-density sphere or box, else false; the header of a rendered image holds the choice) |
 // | `shadow_map_resolution`   | integer in [8, 1024]          | 64        | deep shadow map nodes along the longest axis |
@@ -183,27 +183,19 @@ class MfsIntegrator final : public Integrator {
   std::optional<FootprintProbe> footprint_probe(const Vec3& d, Rng& rng) const;
   // camera_tilt (eq. D16): whether exactly one of p +- u (u the probe's next point of the lateral footprint
   // of depth t) is in a medium; then d_s, the tilted direction, and residual, the share of tau_p left to
-  // the spread. With camera_shift (eq. D17), also where both are: then *shift = u (else 0) and d_s, residual
-  // are u's.
+  // the spread. With camera_shift (eq. D17), also where both are (the bulk): then *bulk is set (and d_s,
+  // residual are not).
   bool tilt(const Vec3& p, const Vec3& d, double t, const CameraPath& cam, FootprintProbe& probe, Vec3* d_s,
-            double* residual, Vec3* shift) const;
-  // camera_shift (eq. D17): the lights' first wide scatter read at ps = p + shift (the medium there: ms)
-  // towards -d_s with the camera-side depth y_s.tau_p; the forward peak and the scatter grid's light at p
-  // as without it.
-  void add_shifted_sources(const MediumPoint& m, const MediumPoint& ms, const Vec3& p, const Vec3& ps,
-                           const Vec3& d, const Vec3& d_s, const ShBasis& y_out, const ShBasis& y_out_s,
-                           double t, const CameraPoint& y, const CameraPoint& y_s, const CameraPath& cam,
-                           Rng& rng, Sources* out) const;
+            double* residual, bool* bulk) const;
   // source_blur (eq. D14): T_cam's light read at a point of the lateral footprint around p, zero outside
   // the media (the forward peak alone stays on the ray: add_sources at p).
   void add_blurred_sources(const Vec3& p, const Vec3& d, const ShBasis& y_out, double t, const CameraPoint& y,
                            const CameraPath& cam, Rng& rng, Sources* out) const;
   // What medium i sends towards the camera from the sample point p (at distance t) of the march: one
   // sample of every light (eqs. D7, D11) and the scatter grid's higher orders (eq. D12).
-  // with_grid false: without the scatter grid's light (L = L_lights).
   MediumRadiance medium_radiance(int i, const Vec3& p, const Vec3& d, const Vec3& d_s, const ShBasis& y_out,
                                  double t, const CameraPoint& y, const CameraPath& cam, Rng& rng,
-                                 const TrilinearStencil* st, bool with_grid = true) const;
+                                 const TrilinearStencil* st) const;
   // Light l's peak-only beam at p for medium i: shadow maps, beam grid (eqs. D8, D9); an area light
   // marches to its sampled point ls instead of reading a map.
   LightBeam light_beam(size_t l, int i, const Vec3& p, const LightSample& ls,

@@ -45,6 +45,7 @@ CameraPoint CameraPath::at(const MfsExtinction& k, double jitter, double dt, boo
                                        tau_red[c] + k.sigma_red[c] * jitter * dt);
   }
   y.tau_p = tau_p + k.sigma_peak * (jitter * dt);
+  y.sigma_red = max_component(k.sigma_red);
   return y;
 }
 
@@ -77,6 +78,10 @@ Vec3 survivor_direction(const CameraPath& cam, double t, const Vec3& d, const Ve
   }
   *residual = std::clamp(1.0 - c * c / (v * m0), 0.0, 1.0);
   return normalize(d + u * (c / v));
+}
+
+Vec3 gradient_tilted(const Vec3& d, const Vec3& wi, double k) {
+  return normalize(d + (wi - d * dot(wi, d)) * k);
 }
 
 namespace {

@@ -37,6 +37,8 @@ struct CameraPoint {
   Rgb T_full;  // plain transmittance y -> camera (the forward-peak paths' last leg, eq. D7)
   Rgb T_cam;   // transmittance of light scattered at y: T_red (times eq. D5) or, light side, T_full
   Rgb tau_p;   // camera-side peak depth at y
+  double sigma_red = 0.0;      // the reduced extinction at y (largest channel)
+  double gradient_tilt = 0.0;  // camera_shift's k (eq. D17; 0: none)
 };
 
 // The camera-side state along the march, from the camera to the current step's start (eqs. D2, D5, D10):
@@ -85,6 +87,11 @@ class FootprintProbe {
 // given that its lateral offset at depth t is u (a draw of the footprint towards the side where the medium
 // is), and the share of the camera-side peak depth left to the spread about it.
 Vec3 survivor_direction(const CameraPath& cam, double t, const Vec3& d, const Vec3& u, double* residual);
+
+// camera_shift (eq. D17): the camera-bound light's mean direction (reversed) d tilted towards wi, the
+// direction towards a light whose beam grows at the rate sigma_red towards it, by
+// k = cov(u, delta) sigma_red: normalize(d + k (wi - (wi . d) d)).
+Vec3 gradient_tilted(const Vec3& d, const Vec3& wi, double k);
 
 // A point of the lateral footprint around the camera ray (direction d) at standard deviation sigma per
 // component (eq. D10): a 2-D Gaussian offset perpendicular to d by Box-Muller from u1, u2 (eq. D14).

@@ -61,6 +61,49 @@ TEST(MfsEstimators, SurvivorDirectionOnAUniformPath) {
 // stratum once, so their mean square length is the footprint's 2 sigma^2 exactly, and each is
 // perpendicular to d; over random starts, one step's offset has mean 0 and variance sigma^2 along each
 // axis of the plane (within 4 standard errors of the sample).
+// eq. D17: for a jointly Gaussian offset u and deflection delta (per component: var v, cov c, var m0) and a
+// source exp(a u) g(delta), the source weighted by exp(a u) reads g as if delta's mean were moved by a c:
+// E[exp(a u) g(delta)] / E[exp(a u)] = E[g(delta + a c)], for any g (here a lopsided bump), by quadrature
+// over the two standard normals. And gradient_tilted moves d towards wi by that angle: atan(k sin theta)
+// in the plane of d and wi, nothing for wi along d.
+TEST(MfsEstimators, GradientTiltIsTheGaussianShiftOfTheDeflection) {
+  const double v = 0.04, c = 0.05, m0 = 0.3, a = 2.9;
+  const auto g = [](double x) { return 1.0 / (1.0 + (x - 0.3) * (x - 0.3)) + 0.2 * x * x * x; };
+  double w_sum = 0.0, wg = 0.0, shifted = 0.0, norm = 0.0;
+  const int n = 801;
+  const double h = 16.0 / (n - 1);
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) {
+      const double z1 = -8.0 + i * h, z2 = -8.0 + j * h;
+      const double p = std::exp(-0.5 * (z1 * z1 + z2 * z2));
+      const double u = std::sqrt(v) * z1, delta = c / std::sqrt(v) * z1 + std::sqrt(m0 - c * c / v) * z2;
+      w_sum += p * std::exp(a * u);
+      wg += p * std::exp(a * u) * g(delta);
+      shifted += p * g(delta + a * c);
+      norm += p;
+    }
+  EXPECT_NEAR(wg / w_sum, shifted / norm, 1e-9 * std::abs(shifted / norm));
+  EXPECT_GT(std::abs(wg / w_sum -
+                     [&] {  // (and the weight matters: unweighted, g reads otherwise)
+                       double s = 0.0;
+                       for (int i = 0; i < n; ++i)
+                         for (int j = 0; j < n; ++j) {
+                           const double z1 = -8.0 + i * h, z2 = -8.0 + j * h;
+                           s += std::exp(-0.5 * (z1 * z1 + z2 * z2)) *
+                                g(c / std::sqrt(v) * z1 + std::sqrt(m0 - c * c / v) * z2);
+                         }
+                       return s / norm;
+                     }()),
+            0.01);
+  const Vec3 d(0.0, 0.0, 1.0), wi = normalize(Vec3(1.0, 0.0, 1.0));  // 45 degrees
+  const Vec3 t = gradient_tilted(d, wi, 0.2);
+  EXPECT_NEAR(std::atan2(t.x, t.z), std::atan(0.2 * std::sin(kPi / 4.0)), 1e-12);
+  EXPECT_EQ(t.y, 0.0);
+  EXPECT_NEAR(t.length(), 1.0, 1e-12);
+  const Vec3 along = gradient_tilted(d, d, 0.2);
+  EXPECT_NEAR((along - d).length(), 0.0, 1e-15);
+}
+
 TEST(MfsEstimators, FootprintProbeHasTheFootprintsMoments) {
   const Vec3 d = normalize(Vec3(0.3, -0.5, 0.8));
   const double sigma = 0.5;
