@@ -243,5 +243,8 @@ Scene builtin_demo_scene();
 inline constexpr int kMaxImageSide = 16384;
 inline constexpr int64_t kMaxImagePixels = int64_t(1) << 26;  // 64 Mpixel: ~1.5 GiB of float buffers
 inline constexpr int kMaxSpp = 1 << 24;
+// The most samples one pixel sample of an outline pixel may take (mfs's edge_samples): a pixel's samples
+// (kMaxSpp x this at most) stay below 2^31.
+inline constexpr int kMaxEdgeSamples = 64;
 
 }  // namespace nimbus

@@ -80,6 +80,10 @@ class Integrator {
   // The integrator's own settings as the JSON fields of its integrator block, with "auto" choices
   // resolved: written into the image header, so that an image says exactly how it was made.
   virtual nlohmann::json settings_json() const = 0;
+  // Samples per pixel sample at pixels a hard outline crosses (scene/edges.h); the pixels beside them take
+  // a quarter of it (at least 1). Their estimates stay the mean of independent samples spread over the
+  // pixel, so nothing is biased: they only get more of them. 1: none.
+  virtual int edge_samples() const { return 1; }
 };
 
 }  // namespace nimbus

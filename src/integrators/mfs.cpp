@@ -58,6 +58,7 @@ MfsSettings mfs_settings_from_json(const nlohmann::json& options, const std::str
   if (bool b = false; o.keyword_or_boolean("exact_light_transmittance", "auto", &b))
     s.exact_light_transmittance = b;
   s.shadow_map_resolution = int(o.integer("shadow_map_resolution", 8, 1024, s.shadow_map_resolution));
+  s.edge_samples = int(o.integer("edge_samples", 1, kMaxEdgeSamples, s.edge_samples));
   o.finish();
   // The light side carries the light to every scatter through peak scatters, with photons in the true
   // medium: other choices would be silently overridden, so they are errors.
@@ -89,7 +90,8 @@ nlohmann::json to_json(const MfsSettings& s) {
                       {"camera_tilt", s.camera_tilt},
                       {"camera_shift", s.camera_shift},
                       {"peak_toward_camera", s.peak_toward_camera},
-                      {"shadow_map_resolution", s.shadow_map_resolution}};
+                      {"shadow_map_resolution", s.shadow_map_resolution},
+                      {"edge_samples", s.edge_samples}};
   j["peak_fraction"] = s.peak_fraction ? nlohmann::json(*s.peak_fraction) : nlohmann::json("auto");
   j["large_angle_scatters"] =
       s.large_angle_scatters ? nlohmann::json(*s.large_angle_scatters) : nlohmann::json("all");

@@ -56,6 +56,7 @@
 // | `peak_toward_camera`      | boolean                       | false     | the forward peak alone takes its angular factor from the beam grid's photons (their P_peak towards the camera) instead of peak_eff at the beam's mean-cosine depth (one medium only) |
 // | `exact_light_transmittance` | "auto" or boolean           | "auto"    | T_light and T_wide to directional and point lights without the shadow maps: the chord in closed form for one constant-density sphere or box, else a march ("auto": true for one constant-density sphere or box, else false; the header of a rendered image holds the choice) |
 // | `shadow_map_resolution`   | integer in [8, 1024]          | 64        | deep shadow map nodes along the longest axis |
+// | `edge_samples`            | integer in [1, 64]            | 16        | samples per pixel sample at pixels a hard outline crosses (constant-density spheres and boxes, surfaces: scene/edges.h), a quarter of it (at least 1) beside them; 1: none (docs/benchmarks.md "Samples at the outlines") |
 //
 // forward_side "light" needs light_path "forward" and photon_transport "exact": the other values are
 // errors naming both fields.
@@ -80,6 +81,7 @@ enum class Propagator { gsa, gaussian };
 enum class PhotonTransport { exact, similarity };
 enum class ForwardSide { camera, light };
 enum class BeamSpread { straight, traced };
+
 
 // The camera march's step in the majorant cells where a medium may emit: at most this optical depth (and
 // tau_step where that is finer). The emission's spatial variation is not blurred by the propagator, so it
@@ -111,6 +113,7 @@ struct MfsSettings {
   bool peak_toward_camera = false;
   std::optional<bool> exact_light_transmittance;  // nullopt: "auto" (resolved by MfsIntegrator)
   int shadow_map_resolution = 64;
+  int edge_samples = 16;
 
   bool forward_light_path() const { return light_path == LightPath::forward; }
   bool light_side() const { return forward_side == ForwardSide::light; }
@@ -134,6 +137,7 @@ class MfsIntegrator final : public Integrator {
   Rgb trace(const Ray& ray, Rng& rng, CameraSample* sample, int bounces) const;
   // The settings with "auto" resolved (scatter_grid_resolution).
   nlohmann::json settings_json() const override { return to_json(s_); }
+  int edge_samples() const override { return s_.edge_samples; }
   const PhaseSplit& split(int medium) const { return *splits_[medium]; }
   const ScatterGrid* scatter_grid() const { return grid_.get(); }
   const BeamGrid* beam_grid() const { return beam_.get(); }

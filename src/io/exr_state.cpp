@@ -68,11 +68,13 @@ void check_state(const FilmState& st) {
     if (l.fraction_bits < 0 || l.fraction_bits > 120)
       throw Error(fmt::format("resume state layer '{}': a grid of 2^-{}", l.name, l.fraction_bits));
   }
-  // Adaptive sampling leaves pixels with fewer samples than the image's spp (the most any pixel took).
+  // Adaptive sampling leaves pixels with fewer samples than the image's spp (the most any pixel took);
+  // outline pixels (mfs's edge_samples) take up to kMaxEdgeSamples per pixel sample.
   if (st.spp > kMaxSpp) throw Error(fmt::format("resume state: {} spp, more than {}", st.spp, kMaxSpp));
   for (uint32_t c : st.counts)
-    if (c > uint32_t(st.spp))
-      throw Error(fmt::format("resume state: a pixel has {} samples, the image at most {}", c, st.spp));
+    if (uint64_t(c) > uint64_t(st.spp) * kMaxEdgeSamples)
+      throw Error(fmt::format("resume state: a pixel has {} samples, more than {} x the image's {} spp", c,
+                              kMaxEdgeSamples, st.spp));
   // Any 128-bit sum is possible (the film saturates at +-(2^127 - 1)); merges add with overflow checks.
 }
 

@@ -4,6 +4,21 @@
 
 namespace nimbus {
 
+bool sphere_chord(const Vec3& center, double radius, const Vec3& o, const Vec3& d, double tmax, double* t0,
+                  double* t1) {
+  // |o + t d - c|^2 = r^2: a t^2 + 2 b t + c = 0, the roots in the cancellation-free form.
+  const Vec3 oc = o - center;
+  const double a = dot(d, d), b = dot(d, oc), c = dot(oc, oc) - radius * radius;
+  const double disc = b * b - a * c;
+  if (!(disc > 0.0) || !(a > 0.0)) return false;
+  const double q = -(b + std::copysign(std::sqrt(disc), b));
+  double r0 = q / a, r1 = q != 0.0 ? c / q : -r0;
+  if (r0 > r1) std::swap(r0, r1);
+  *t0 = std::max(r0, 0.0);
+  *t1 = std::min(r1, tmax);
+  return *t0 <= *t1;
+}
+
 AnalyticMedia::AnalyticMedia(const SceneMedia& media) {
   active_ = media.count() > 0 && !media.emits();
   for (int i = 0; i < media.count() && active_; ++i) {
@@ -38,17 +53,7 @@ bool AnalyticMedia::chord(int i, const Vec3& o, const Vec3& d, double tmax, doub
   const bool identity = m.to_local.is_identity();
   const Vec3 lo = identity ? o : m.to_local.point(o), ld = identity ? d : m.to_local.vector(d);
   if (!m.sphere) return m.box.intersect(lo, ld, 0.0, tmax, t0, t1);
-  // |lo + t ld - c|^2 = r^2: a t^2 + 2 b t + c = 0, the roots in the cancellation-free form.
-  const Vec3 oc = lo - m.center;
-  const double a = dot(ld, ld), b = dot(ld, oc), c = dot(oc, oc) - m.radius * m.radius;
-  const double disc = b * b - a * c;
-  if (!(disc > 0.0) || !(a > 0.0)) return false;
-  const double q = -(b + std::copysign(std::sqrt(disc), b));
-  double r0 = q / a, r1 = q != 0.0 ? c / q : -r0;
-  if (r0 > r1) std::swap(r0, r1);
-  *t0 = std::max(r0, 0.0);
-  *t1 = std::min(r1, tmax);
-  return *t0 <= *t1;
+  return sphere_chord(m.center, m.radius, lo, ld, tmax, t0, t1);
 }
 
 Rgb AnalyticMedia::transmittance(const Vec3& o, const Vec3& d, double tmax) const {

@@ -17,6 +17,11 @@
 
 namespace nimbus {
 
+// The parametric interval [*t0, *t1] of the sphere (center, radius) along o + t d within [0, tmax] (d need
+// not be unit); false when the ray misses it there.
+bool sphere_chord(const Vec3& center, double radius, const Vec3& o, const Vec3& d, double tmax, double* t0,
+                  double* t1);
+
 class AnalyticMedia {
  public:
   AnalyticMedia() = default;  // inactive (tests: the majorant-grid path on analytic shapes)

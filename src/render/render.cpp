@@ -27,6 +27,7 @@
 #include "render/film.h"
 #include "render/film_layers.h"
 #include "render/time_film.h"
+#include "scene/edges.h"
 
 namespace nimbus {
 
@@ -104,6 +105,12 @@ struct PixelTargets {
   std::vector<std::vector<DeepSample>>* deep_pixels;  // per pixel, when deep_samples > 0
   int adaptive_layer = -1;        // adaptive sampling: the film layer of kAdaptiveLayer (render/adaptive.h)
   TimeFilm* time_film = nullptr;  // a transient render (film.time_bins)
+  // Per pixel of the window, row by row: the samples each of its pixel samples takes (k: pixel sample s
+  // is samples k s .. k s + k - 1); null: 1 everywhere (Integrator::edge_samples, scene/edges.h).
+  const std::vector<int>* sample_factor = nullptr;
+  int factor(int x, int y) const {
+    return sample_factor ? (*sample_factor)[size_t(y - y0) * size_t(film.width()) + size_t(x - x0)] : 1;
+  }
 };
 
 // Positions in pixel (x, y): the R2 sequence rotated by the pixel's own random offset, drawn from the
@@ -125,7 +132,8 @@ struct PixelSequence {
 // Samples of pixel (x, y) into the film. Positions in the pixel: the R2 sequence (Roberts 2018), shifted
 // by a random offset per pixel (a Cranley-Patterson rotation, so each sample is still uniform over the
 // pixel and the estimate unbiased); its samples are spread evenly for every spp, which halves edge noise
-// at a few spp. Samples [s0, s1) of the pixel, added in order (a deep pixel takes all its samples in one
+// at a few spp. Pixel samples [s0, s1) of the pixel (its samples k s0 .. k s1 - 1, where it takes k per
+// pixel sample: PixelTargets::sample_factor), added in order (a deep pixel takes all its samples in one
 // call). Returns the number of non-finite samples (dropped).
 int64_t render_pixel(const Integrator& integrator, const PinholeCamera& camera,
                      const IntegratorSettings& settings, int x, int y, int s0, int s1,
@@ -135,8 +143,9 @@ int64_t render_pixel(const Integrator& integrator, const PinholeCamera& camera,
   thread_local std::vector<DeepSegment> segments, sample_segments;
   thread_local std::vector<TimedContribution> timed;
   segments.clear();
-  s0 += to.sample_start;
-  s1 += to.sample_start;
+  const int k = to.factor(x, y);
+  s0 = k * (s0 + to.sample_start);
+  s1 = k * (s1 + to.sample_start);
   for (int s = s0; s < s1; ++s) {
     Rng rng = Rng::for_sample(settings.seed, uint32_t(x), uint32_t(y), uint64_t(s));
     const auto [jx, jy] = positions.at(s);
@@ -156,7 +165,7 @@ int64_t render_pixel(const Integrator& integrator, const PinholeCamera& camera,
   }
   if (to.deep_samples > 0) {
     const size_t i = size_t(y) * size_t(to.film.width()) + size_t(x);
-    merge_deep_segments(segments, 1.0 / settings.spp, to.deep_samples, &(*to.deep_pixels)[i]);
+    merge_deep_segments(segments, 1.0 / (double(settings.spp) * k), to.deep_samples, &(*to.deep_pixels)[i]);
   }
   return bad;
 }
@@ -197,6 +206,18 @@ DeepImage assemble_deep(int width, int height, std::vector<std::vector<DeepSampl
     std::vector<DeepSample>().swap(p);
   }
   return deep;
+}
+
+// Samples per pixel sample of each pixel of the window (Integrator::edge_samples at the pixels an outline
+// crosses, a quarter of it beside them); empty where every pixel takes 1.
+std::vector<int> sample_factors(const SceneContext& ctx, const Integrator& integrator, const Region& window) {
+  const int n = integrator.edge_samples();
+  if (n <= 1) return {};
+  const std::vector<PixelEdge> edges = edge_pixels(ctx, window);
+  std::vector<int> k(edges.size(), 1);
+  for (size_t i = 0; i < edges.size(); ++i)
+    if (edges[i] != PixelEdge::none) k[i] = edges[i] == PixelEdge::outline ? n : std::max(1, n / 4);
+  return k;
 }
 
 using Clock = std::chrono::steady_clock;
@@ -250,7 +271,7 @@ bool render_pass(PassContext& pc, tbb::task_arena& arena, int s0, int s1) {
           render_probes(pc.integrator, pc.camera, pc.settings, x, y, p0, int((*pc.probe)[i]), pc.targets);
         }
         tile_bad += render_pixel(pc.integrator, pc.camera, pc.settings, x, y, a, b, pc.targets);
-        tile_samples += b - a;
+        tile_samples += int64_t(b - a) * pc.targets.factor(x, y);
       }
     }
     bad += tile_bad;
@@ -364,6 +385,9 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
         "environments, suns, point, spot and area lights are)");
   std::optional<TimeFilm> time_film;
   if (scene.film.time_bins) time_film.emplace(W, H, *scene.film.time_bins, film_settings.transparent);
+  // Outline pixels take more samples (not in adaptive sampling, which gives each pixel its own count).
+  std::vector<int> factors;
+  if (adaptive_layer < 0) arena.execute([&] { factors = sample_factors(*context, *integrator, window); });
   const PixelTargets targets{film,
                              window.x0,
                              window.y0,
@@ -372,7 +396,10 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
                              options.deep_samples,
                              &deep_pixels,
                              adaptive_layer,
-                             time_film ? &*time_film : nullptr};
+                             time_film ? &*time_film : nullptr,
+                             factors.empty() ? nullptr : &factors};
+  int64_t factor_sum = int64_t(W) * H;  // samples per pixel sample over the window
+  for (int k : factors) factor_sum += k - 1;
 
   bool first = true;
   auto cancelled = [&] { return options.cancel && options.cancel->load(std::memory_order_relaxed); };
@@ -386,7 +413,7 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
                  targets,
                  window,
                  [&] { return cancelled() || over_time(); }};
-  pc.total = int64_t(W) * H * (settings.spp - done);
+  pc.total = factor_sum * (settings.spp - done);
   const bool stoppable = options.cancel || options.time_limit > 0.0;
   double seconds_per_spp = 0.0;
   while (done < settings.spp && !adaptive) {

@@ -97,7 +97,7 @@ TEST(Registry, DefaultsAreWrittenOut) {
   EXPECT_EQ(mfs["camera_shift"], false);
   EXPECT_EQ(mfs["exact_light_transmittance"], "auto");
   EXPECT_EQ(mfs["beam_spread"], "straight");
-  EXPECT_EQ(mfs.size(), 24u);  // every option of the table in mfs.h
+  EXPECT_EQ(mfs.size(), 25u);  // every option of the table in mfs.h
 }
 
 TEST(Registry, UnknownFieldsAndNamesAreErrors) {

@@ -5,10 +5,12 @@
 
 #include <atomic>
 #include <cstring>
+#include <map>
 
 #include "nimbus/error.h"
 #include "nimbus/image.h"
 #include "nimbus/render.h"
+#include "scene/edges.h"
 #include "support/bitwise.h"
 #include "support/scenes.h"
 #include "support/scratch_dir.h"
@@ -72,6 +74,47 @@ TEST(Progressive, ResumedRenderEqualsOneRenderBitForBit) {
     // And the resumed image differs from a render of fewer samples (the test can fail).
     EXPECT_FALSE(test::same_floats(part.image.rgb, resumed.image.rgb));
   }
+}
+
+// mfs's edge_samples n: an outline pixel's samples at s spp are the pixel's samples at n s spp without it
+// (the same sample indices, so the same positions and random streams), bit for bit; beside it n / 4 s;
+// elsewhere s. So nothing is biased, and resumed or windowed renders stay exact.
+TEST(Progressive, OutlinePixelsTakeTheSamplesOfAHigherSpp) {
+  const std::string mfs = R"("mfs", "photons": 4096, "beam_photons": 1024, "edge_samples": )";
+  const Scene edges = test_scene(mfs + "8"), plain = test_scene(mfs + "1");
+  const int W = 20, H = 16;
+  const SceneContext ctx(edges);
+  const std::vector<PixelEdge> classes = edge_pixels(ctx, Region{0, 0, W, H});
+  RenderOptions o;
+  o.threads = 2;
+  o.spp = 1;
+  const RenderResult r = render(edges, o);
+  std::map<int, RenderResult> without;
+  for (int spp : {1, 2, 8}) {
+    o.spp = spp;
+    without[spp] = render(plain, o);
+  }
+  std::map<PixelEdge, int> seen;
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      const size_t i = size_t(y) * W + x;
+      const int k = classes[i] == PixelEdge::outline ? 8 : classes[i] == PixelEdge::beside ? 2 : 1;
+      EXPECT_EQ(r.state.counts[i], uint32_t(k)) << x << " " << y;
+      EXPECT_EQ(std::memcmp(r.image.pixel(x, y), without[k].image.pixel(x, y), 3 * sizeof(float)), 0)
+          << x << " " << y;
+      ++seen[classes[i]];
+    }
+  EXPECT_GT(seen[PixelEdge::outline], 10);
+  EXPECT_GT(seen[PixelEdge::beside], 10);
+  // A window through the outline is the whole image's crop (its pixels beside an outline pixel outside it
+  // take their samples too).
+  o.spp = 1;
+  o.region = Region{3, 2, 15, 11};
+  const RenderResult w = render(edges, o);
+  for (int y = 2; y < 11; ++y)
+    for (int x = 3; x < 15; ++x)
+      EXPECT_EQ(std::memcmp(w.image.pixel(x - 3, y - 2), r.image.pixel(x, y), 3 * sizeof(float)), 0)
+          << x << " " << y;
 }
 
 TEST(Progressive, CancelledRenderIsTheWholeImageOfItsLastPass) {
@@ -169,9 +212,10 @@ TEST(Progressive, FilmStateSurvivesTheExr) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("b.exr"), std::string::npos);
   }
-  // A state whose counts disagree with its spp is refused at writing.
+  // A state whose counts disagree with its spp (more samples than even an outline pixel takes) is refused
+  // at writing.
   FilmState bad = r.state;
-  bad.counts[0] = 7;
+  bad.counts[0] = uint32_t(bad.spp) * kMaxEdgeSamples + 1;
   EXPECT_THROW(write_exr(scratch.path / "c.exr", r.image, {}, &bad), Error);
   EXPECT_FALSE(std::filesystem::exists(scratch.path / "c.exr"));
 }
