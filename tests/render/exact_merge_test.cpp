@@ -113,8 +113,8 @@ Scene merge_scene(const std::string& integrator) {
     "lights": [{"type": "directional", "direction": [1, 1, -1], "irradiance": 2.0},
                {"type": "environment", "radiance": 0.2}],
     "film": {"layers": ["depth", "direct", "transmittance"]},
-    "integrator": {"type": )" +
-                               integrator + R"(, "spp": 7, "seed": 5}})");
+    "integrator": {"type": )" + integrator +
+                               R"(, "spp": 7, "seed": 5}})");
 }
 
 TEST(ExactFilm, SampleRangesAddUpToTheRenderOfAllSamplesBitForBit) {

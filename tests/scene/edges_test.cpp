@@ -43,8 +43,9 @@ TEST(Edges, OutlinePixelsAreThoseTheSilhouetteCrosses) {
       bool beside = false;
       for (int v = std::max(y - 1, 0); v <= std::min(y + 1, kH - 1); ++v)
         for (int u = std::max(x - 1, 0); u <= std::min(x + 1, kW - 1); ++u) beside |= corners_differ(u, v);
-      const PixelEdge want =
-          corners_differ(x, y) ? PixelEdge::outline : beside ? PixelEdge::beside : PixelEdge::none;
+      const PixelEdge want = corners_differ(x, y) ? PixelEdge::outline
+                             : beside             ? PixelEdge::beside
+                                                  : PixelEdge::none;
       EXPECT_EQ(int(e[size_t(y) * kW + x]), int(want)) << x << " " << y;
       outline += want == PixelEdge::outline;
       // Every pixel the silhouette crosses (seen on a 9 x 9 grid of points in it) takes more samples.
