@@ -53,9 +53,16 @@ std::vector<PixelEdge> edge_pixels(const SceneContext& ctx, const Region& window
   const int x0 = std::max(window.x0 - 1, 0), y0 = std::max(window.y0 - 1, 0);
   const int x1 = std::min(window.x1 + 1, W), y1 = std::min(window.y1 + 1, H);
   const int gw = x1 - x0, gh = y1 - y0;
+  const int ww = window.x1 - window.x0, wh = window.y1 - window.y0;
+  std::vector<PixelEdge> out(size_t(ww) * size_t(wh), PixelEdge::none);
   std::vector<Transform> to_local;
-  for (int i = 0; i < std::min(ctx.media.count(), 64); ++i)
-    to_local.push_back(ctx.media.medium(i).transform.inverse());
+  bool shapes = false;
+  for (int i = 0; i < std::min(ctx.media.count(), 64); ++i) {
+    const Medium& m = ctx.media.medium(i);
+    shapes |= std::holds_alternative<SphereShape>(m.shape) || std::holds_alternative<BoxShape>(m.shape);
+    to_local.push_back(m.transform.inverse());
+  }
+  if (!shapes && ctx.surfaces.empty()) return out;  // density grids alone: no hard outline
   std::vector<Sight> corners(size_t(gw + 1) * size_t(gh + 1));
   tbb::parallel_for(0, gh + 1, [&](int j) {
     for (int i = 0; i <= gw; ++i) corners[size_t(j) * (gw + 1) + i] = sight(ctx, to_local, x0 + i, y0 + j);
@@ -68,8 +75,6 @@ std::vector<PixelEdge> edge_pixels(const SceneContext& ctx, const Region& window
           !(corners[size_t(j) * (gw + 1) + i + 1] == a && corners[size_t(j + 1) * (gw + 1) + i] == a &&
             corners[size_t(j + 1) * (gw + 1) + i + 1] == a);
     }
-  const int ww = window.x1 - window.x0, wh = window.y1 - window.y0;
-  std::vector<PixelEdge> out(size_t(ww) * size_t(wh), PixelEdge::none);
   for (int y = window.y0; y < window.y1; ++y)
     for (int x = window.x0; x < window.x1; ++x) {
       PixelEdge& e = out[size_t(y - window.y0) * ww + (x - window.x0)];
