@@ -225,7 +225,7 @@ spp, integrator, seed: override the scene's integrator block (another integrator
   starts from its own defaults, as `nimbus render --integrator` does).
 threads: worker threads, 0 = all cores (the image is the same for any count).
 layers: compositing layers to keep besides RGBA, e.g. ['depth', 'direct'] (names: nimbus.layer_names()).
-progress: called as progress(done, total) with the pixel samples taken and to take, from the calling
+progress: called as progress(done, total) with the samples taken and to take (over all pixels), from the calling
   thread, at most every 50 ms and once at the end.
 time_limit: a budget in seconds; the render takes whole passes (1, 2, 4, ... spp) while they fit.
 noise: adaptive sampling, as `nimbus render --noise`: passes until the estimated binned relative RMSE

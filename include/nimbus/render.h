@@ -87,8 +87,9 @@ struct RenderResult {
   int64_t nonfinite_samples = 0;  // NaN/inf (or beyond 4.6e18: render/film.h) samples dropped (this run)
   double seconds = 0.0;
   std::string integrator;
-  int spp = 0;                  // samples per pixel in the image (adaptive: the most any pixel took)
-  double spp_mean = 0.0;        // the mean over pixels (adaptive sampling; = spp otherwise)
+  int spp = 0;            // samples per pixel in the image (adaptive: the most any pixel took)
+  double spp_mean = 0.0;  // samples per pixel, the mean over pixels (adaptive sampling, and mfs's outline
+                          // pixels, which take edge_samples per pixel sample: scene/edges.h; = spp otherwise)
   double noise_target = 0.0;    // RenderOptions::noise (0: not adaptive)
   double noise_estimate = 0.0;  // adaptive sampling: the estimated binned relative RMSE reached
   int spp_requested = 0;        // what the render asked for

@@ -82,7 +82,6 @@ enum class PhotonTransport { exact, similarity };
 enum class ForwardSide { camera, light };
 enum class BeamSpread { straight, traced };
 
-
 // The camera march's step in the majorant cells where a medium may emit: at most this optical depth (and
 // tau_step where that is finer). The emission's spatial variation is not blurred by the propagator, so it
 // needs the steps the old default of tau_step (0.1) gave it (docs/benchmarks.md, issue 12).

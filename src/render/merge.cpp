@@ -264,6 +264,11 @@ MergeResult merge_renders(const std::vector<std::filesystem::path>& files) {
   r.state = std::move(st);
   r.sample_start = start;
   r.metadata = merged_metadata(inputs[0], inputs.size(), start, end - start, w, whole, seconds);
+  // The merged pixels' mean sample count (mfs's outline pixels take more than the spp).
+  double count_sum = 0.0;
+  for (uint32_t c : r.state.counts) count_sum += c;
+  for (auto& [k, v] : r.metadata)
+    if (k == "nimbus/spp_mean") v = fmt::format("{:.3f}", count_sum / double(r.state.counts.size()));
   return r;
 }
 

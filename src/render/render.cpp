@@ -107,7 +107,7 @@ struct PixelTargets {
   TimeFilm* time_film = nullptr;  // a transient render (film.time_bins)
   // Per pixel of the window, row by row: the samples each of its pixel samples takes (k: pixel sample s
   // is samples k s .. k s + k - 1); null: 1 everywhere (Integrator::edge_samples, scene/edges.h).
-  const std::vector<int>* sample_factor = nullptr;
+  const std::vector<uint8_t>* sample_factor = nullptr;
   int factor(int x, int y) const {
     return sample_factor ? (*sample_factor)[size_t(y - y0) * size_t(film.width()) + size_t(x - x0)] : 1;
   }
@@ -210,14 +210,31 @@ DeepImage assemble_deep(int width, int height, std::vector<std::vector<DeepSampl
 
 // Samples per pixel sample of each pixel of the window (Integrator::edge_samples at the pixels an outline
 // crosses, a quarter of it beside them); empty where every pixel takes 1.
-std::vector<int> sample_factors(const SceneContext& ctx, const Integrator& integrator, const Region& window) {
-  const int n = integrator.edge_samples();
+std::vector<uint8_t> sample_factors(const SceneContext& ctx, const Integrator& integrator,
+                                    const Region& window) {
+  const int n = std::min(integrator.edge_samples(), kMaxEdgeSamples);
   if (n <= 1) return {};
   const std::vector<PixelEdge> edges = edge_pixels(ctx, window);
-  std::vector<int> k(edges.size(), 1);
+  std::vector<uint8_t> k(edges.size(), 1);
   for (size_t i = 0; i < edges.size(); ++i)
-    if (edges[i] != PixelEdge::none) k[i] = edges[i] == PixelEdge::outline ? n : std::max(1, n / 4);
+    if (edges[i] != PixelEdge::none) k[i] = uint8_t(edges[i] == PixelEdge::outline ? n : std::max(1, n / 4));
   return k;
+}
+
+// A resumed film (not an adaptive one) must hold exactly the samples its `done` pixel samples gave each
+// pixel (k of them per pixel sample at outline pixels): a state of an earlier nimbus, whose outline pixels
+// took no more samples, or of another edge_samples would otherwise be continued from the wrong samples.
+void check_resumed_counts(const Film& film, const std::vector<uint8_t>& factors, int done, const Region& w) {
+  for (int y = 0; y < film.height(); ++y)
+    for (int x = 0; x < film.width(); ++x) {
+      const size_t i = size_t(y) * size_t(film.width()) + size_t(x);
+      const int64_t want = int64_t(factors.empty() ? 1 : factors[i]) * done;
+      if (int64_t(film.samples(x, y)) != want)
+        throw Error(fmt::format(
+            "resume: pixel ({}, {}) has {} samples where {} spp give it {} (an image of an earlier nimbus, "
+            "whose pixels on a silhouette took no more samples, or of other edge_samples): render it again",
+            x + w.x0, y + w.y0, film.samples(x, y), done, want));
+    }
 }
 
 using Clock = std::chrono::steady_clock;
@@ -386,8 +403,9 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
   std::optional<TimeFilm> time_film;
   if (scene.film.time_bins) time_film.emplace(W, H, *scene.film.time_bins, film_settings.transparent);
   // Outline pixels take more samples (not in adaptive sampling, which gives each pixel its own count).
-  std::vector<int> factors;
+  std::vector<uint8_t> factors;
   if (adaptive_layer < 0) arena.execute([&] { factors = sample_factors(*context, *integrator, window); });
+  if (options.resume && adaptive_layer < 0) check_resumed_counts(film, factors, done, window);
   const PixelTargets targets{film,
                              window.x0,
                              window.y0,
@@ -399,7 +417,7 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
                              time_film ? &*time_film : nullptr,
                              factors.empty() ? nullptr : &factors};
   int64_t factor_sum = int64_t(W) * H;  // samples per pixel sample over the window
-  for (int k : factors) factor_sum += k - 1;
+  for (uint8_t k : factors) factor_sum += k - 1;
 
   bool first = true;
   auto cancelled = [&] { return options.cancel && options.cancel->load(std::memory_order_relaxed); };

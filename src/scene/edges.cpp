@@ -13,7 +13,7 @@ namespace nimbus {
 namespace {
 
 // What a ray sees of the outlines: the first surface it meets (-1: none) and the sphere and box media it
-// crosses before that surface (bit i for medium i; media past the 64th are not told apart).
+// crosses before that surface (bit i for medium i; media past the 64th are left out).
 struct Sight {
   int surface = -1;
   uint64_t media = 0;
@@ -63,18 +63,18 @@ std::vector<PixelEdge> edge_pixels(const SceneContext& ctx, const Region& window
     to_local.push_back(m.transform.inverse());
   }
   if (!shapes && ctx.surfaces.empty()) return out;  // density grids alone: no hard outline
-  std::vector<Sight> corners(size_t(gw + 1) * size_t(gh + 1));
-  tbb::parallel_for(0, gh + 1, [&](int j) {
-    for (int i = 0; i <= gw; ++i) corners[size_t(j) * (gw + 1) + i] = sight(ctx, to_local, x0 + i, y0 + j);
-  });
+  // Row by row (each row's two lines of corner rays of its own: the corners of the image are never held
+  // at once).
   std::vector<uint8_t> outline(size_t(gw) * size_t(gh));
-  for (int j = 0; j < gh; ++j)
-    for (int i = 0; i < gw; ++i) {
-      const Sight& a = corners[size_t(j) * (gw + 1) + i];
-      outline[size_t(j) * gw + i] =
-          !(corners[size_t(j) * (gw + 1) + i + 1] == a && corners[size_t(j + 1) * (gw + 1) + i] == a &&
-            corners[size_t(j + 1) * (gw + 1) + i + 1] == a);
+  tbb::parallel_for(0, gh, [&](int j) {
+    std::vector<Sight> top(size_t(gw) + 1), bottom(size_t(gw) + 1);
+    for (int i = 0; i <= gw; ++i) {
+      top[i] = sight(ctx, to_local, x0 + i, y0 + j);
+      bottom[i] = sight(ctx, to_local, x0 + i, y0 + j + 1);
     }
+    for (int i = 0; i < gw; ++i)
+      outline[size_t(j) * gw + i] = !(top[i + 1] == top[i] && bottom[i] == top[i] && bottom[i + 1] == top[i]);
+  });
   for (int y = window.y0; y < window.y1; ++y)
     for (int x = window.x0; x < window.x1; ++x) {
       PixelEdge& e = out[size_t(y - window.y0) * ww + (x - window.x0)];

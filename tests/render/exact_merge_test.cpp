@@ -150,6 +150,9 @@ TEST(ExactFilm, SampleRangesAddUpToTheRenderOfAllSamplesBitForBit) {
     EXPECT_LT(zeros, int64_t(whole.state.layers[0].sums.size() / 4));
     sum.spp = 7;
     EXPECT_EQ(sum.counts, whole.state.counts);
+    // mfs's outline pixels took 16 per pixel sample (the other integrators' pixels 7 each).
+    const uint32_t most = *std::max_element(whole.state.counts.begin(), whole.state.counts.end());
+    EXPECT_EQ(most, integrator.find("mfs") != std::string::npos ? 16u * 7u : 7u);
     ASSERT_EQ(sum.layers.size(), whole.state.layers.size());
     for (size_t l = 0; l < sum.layers.size(); ++l) {
       EXPECT_EQ(sum.layers[l].name, whole.state.layers[l].name);

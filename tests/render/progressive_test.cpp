@@ -106,6 +106,18 @@ TEST(Progressive, OutlinePixelsTakeTheSamplesOfAHigherSpp) {
     }
   EXPECT_GT(seen[PixelEdge::outline], 10);
   EXPECT_GT(seen[PixelEdge::beside], 10);
+  // A film whose outline pixels took other counts (an earlier nimbus, other edge_samples) is not continued.
+  RenderOptions more;
+  more.threads = 2;
+  more.spp = 2;
+  more.resume = &r.state;
+  try {
+    render(test_scene(mfs + "4"), more);
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("resume: pixel"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(render(edges, more).spp, 2);  // the same edge_samples continues it
   // A window through the outline is the whole image's crop (its pixels beside an outline pixel outside it
   // take their samples too).
   o.spp = 1;
