@@ -64,17 +64,42 @@ TEST(Edges, OutlinePixelsAreThoseTheSilhouetteCrosses) {
 TEST(Edges, AWindowsClassesAreThoseOfTheWholeImage) {
   const SceneContext ctx(sphere_scene());
   const std::vector<PixelEdge> whole = edge_pixels(ctx, Region{0, 0, kW, kH});
-  const Region w{7, 4, 23, 19};  // a window the outline crosses, its borders through outline pixels
-  const std::vector<PixelEdge> part = edge_pixels(ctx, w);
-  ASSERT_EQ(part.size(), size_t((w.x1 - w.x0) * (w.y1 - w.y0)));
-  int outline = 0;
-  for (int y = w.y0; y < w.y1; ++y)
-    for (int x = w.x0; x < w.x1; ++x) {
-      const PixelEdge p = part[size_t(y - w.y0) * (w.x1 - w.x0) + (x - w.x0)];
-      EXPECT_EQ(int(p), int(whole[size_t(y) * kW + x])) << x << " " << y;
-      outline += p == PixelEdge::outline;
-    }
-  EXPECT_GT(outline, 5);
+  // A window the outline crosses, its borders through outline pixels, and one at the image's corner.
+  for (const Region& w : {Region{7, 4, 23, 19}, Region{0, 0, 14, 12}, Region{30, 20, kW, kH}}) {
+    const std::vector<PixelEdge> part = edge_pixels(ctx, w);
+    ASSERT_EQ(part.size(), size_t((w.x1 - w.x0) * (w.y1 - w.y0)));
+    int outline = 0;
+    for (int y = w.y0; y < w.y1; ++y)
+      for (int x = w.x0; x < w.x1; ++x) {
+        const PixelEdge p = part[size_t(y - w.y0) * (w.x1 - w.x0) + (x - w.x0)];
+        EXPECT_EQ(int(p), int(whole[size_t(y) * kW + x])) << x << " " << y;
+        outline += p == PixelEdge::outline;
+      }
+    EXPECT_GT(outline, 2) << w.x0 << " " << w.y0;
+  }
+}
+
+TEST(Edges, AMediumsTransformMovesItsOutline) {
+  // The sphere of sphere_scene() (centre (0.3, 0, 0.1)) made as a unit sphere at the origin, scaled by 1
+  // and moved there by its transform: the same classes. Moved elsewhere: others.
+  const std::string moved = R"(,
+    "media": [{"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1}, "sigma_s": 4.0,
+               "transform": {"translate": [0.3, 0, 0.1]}}],
+    "lights": [{"type": "directional", "direction": [0, 1, 0], "irradiance": 1}]})";
+  const SceneContext a(sphere_scene()),
+      b(test::scene_from_json("{" + test::camera_json(kW, kH, 30.0, 5.0) + moved));
+  const Region all{0, 0, kW, kH};
+  const std::vector<PixelEdge> ea = edge_pixels(a, all), eb = edge_pixels(b, all);
+  int differ = 0;
+  for (size_t i = 0; i < ea.size(); ++i) differ += ea[i] != eb[i];
+  EXPECT_LE(differ, 2);  // corner rays within rounding of the silhouette may fall either way
+  std::string shifted = moved;
+  shifted.replace(shifted.find("0.3, 0, 0.1"), 11, "0.6, 0, 0.1");
+  const SceneContext c(test::scene_from_json("{" + test::camera_json(kW, kH, 30.0, 5.0) + shifted));
+  const std::vector<PixelEdge> ec = edge_pixels(c, all);
+  differ = 0;
+  for (size_t i = 0; i < ea.size(); ++i) differ += ea[i] != ec[i];
+  EXPECT_GT(differ, 20);
 }
 
 TEST(Edges, ASurfaceInFrontHidesTheOutlineBehindIt) {
