@@ -172,9 +172,10 @@ std::pair<int, int> check_coverage(const std::vector<Input>& inputs, const Windo
   return *range;
 }
 
-// The header of the merged image: the first input's, with the merged spp, sample range and window.
-ImageMetadata merged_metadata(const Input& first, size_t inputs, int start, int spp, const Window& w,
-                              bool whole, double seconds) {
+// The header of the merged image: the first input's, with the merged spp, sample range, window and mean
+// sample count per pixel (mfs's outline pixels take more than the spp).
+ImageMetadata merged_metadata(const Input& first, size_t inputs, int start, int spp, double spp_mean,
+                              const Window& w, bool whole, double seconds) {
   nlohmann::json scene = meta_json(first, "nimbus/scene");
   nlohmann::json settings = meta_json(first, "nimbus/integrator_settings");
   settings["spp"] = spp;
@@ -189,6 +190,7 @@ ImageMetadata merged_metadata(const Input& first, size_t inputs, int start, int 
     if (k == "nimbus/scene") value = scene.dump();
     if (k == "nimbus/partial" || k == "nimbus/time_limited") value = "false";
     if (k == "nimbus/render_seconds") value = fmt::format("{:.3f}", seconds);
+    if (k == "nimbus/spp_mean") value = fmt::format("{:.3f}", spp_mean);
     meta.emplace_back(k, value);
   }
   if (!whole) meta.emplace_back("nimbus/region", fmt::format("{},{},{},{}", w.x0, w.y0, w.x1, w.y1));
@@ -263,12 +265,10 @@ MergeResult merge_renders(const std::vector<std::filesystem::path>& files) {
   }
   r.state = std::move(st);
   r.sample_start = start;
-  r.metadata = merged_metadata(inputs[0], inputs.size(), start, end - start, w, whole, seconds);
-  // The merged pixels' mean sample count (mfs's outline pixels take more than the spp).
   double count_sum = 0.0;
   for (uint32_t c : r.state.counts) count_sum += c;
-  for (auto& [k, v] : r.metadata)
-    if (k == "nimbus/spp_mean") v = fmt::format("{:.3f}", count_sum / double(r.state.counts.size()));
+  r.metadata = merged_metadata(inputs[0], inputs.size(), start, end - start,
+                               count_sum / double(r.state.counts.size()), w, whole, seconds);
   return r;
 }
 
