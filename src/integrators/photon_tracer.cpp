@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "integrators/env_light.h"
 #include "scene/area_lights.h"
@@ -72,6 +73,101 @@ Photon emit(const SceneContext& ctx, size_t source, const Vec3& c, double r, dou
     p.x = through_disc(p.w);
     p.power = pdf > 0.0 ? ctx.environment_radiance(wi) * (disc_area / (pdf * n)) : Rgb(0.0);
   }
+  return p;
+}
+
+namespace {
+
+// A point of the plane through c normal to w, from emit_with_surfaces' mixture (u0 < kAimedShare: uniform
+// on the disc of radius r, else the density h / (2 pi (h^2 + rho^2)^(3/2)) over the plane), `back` behind
+// it along w. *area: 1 / the mixture's density there. h: the distance from c along w to the first surface
+// (at least r): a ground h below sends the media light from a distance rho along it as h / (h^2 +
+// rho^2)^(3/2) (the solid angle of the media times the cosine at the ground), the density itself.
+Vec3 plane_point(const SceneContext& ctx, const Vec3& c, const Vec3& w, double r, double back, double u0,
+                 double u1, double u2, double* area) {
+  SurfaceHit hit;
+  const double h =
+      ctx.surfaces.intersect(c, w, std::numeric_limits<double>::infinity(), &hit) ? std::max(r, hit.t) : r;
+  const double v = 1.0 - u1;  // in (0, 1]
+  const double rho = u0 < kAimedShare ? r * std::sqrt(u1) : h * std::sqrt(std::max(0.0, 1.0 / (v * v) - 1.0));
+  const double phi = 2.0 * kPi * u2, s = std::sqrt(h * h + rho * rho);
+  const double density =
+      kAimedShare * (rho < r ? 1.0 / (kPi * r * r) : 0.0) + (1.0 - kAimedShare) * h / (2.0 * kPi * s * s * s);
+  *area = 1.0 / density;
+  return c - w * back + Frame(w).to_world({rho * std::cos(phi), rho * std::sin(phi), 0.0});
+}
+
+// A point or spot light's photon of emit_with_surfaces: the cone towards the media's sphere (cos_aim) with
+// probability kAimedShare, else a uniform direction of the light's whole range (a sphere, or the spot's
+// cone cos_spot); the power over the mixture's density.
+Photon point_with_surfaces(const Vec3& x, const Vec3& to_c, double cos_aim, const SpotLight* spot,
+                           const Rgb& intensity, double n, double u0, double u1, double u2) {
+  const double cos_all = spot ? std::cos(0.5 * spot->cone_angle_deg * kPi / 180.0) : -1.0;
+  const Vec3 axis_all = spot ? spot->direction : Vec3(0, 0, 1);
+  Photon p;
+  p.x = x;
+  p.w = u0 < kAimedShare ? spherical_direction(1.0 - u1 * (1.0 - cos_aim), 2.0 * kPi * u2, to_c)
+                         : spherical_direction(1.0 - u1 * (1.0 - cos_all), 2.0 * kPi * u2, axis_all);
+  const bool in_aim = dot(p.w, to_c) >= cos_aim;
+  const bool in_all = !spot || dot(p.w, spot->direction) >= cos_all;
+  const double pdf = kAimedShare * (in_aim ? 1.0 / (2.0 * kPi * (1.0 - cos_aim)) : 0.0) +
+                     (1.0 - kAimedShare) * (in_all ? 1.0 / (2.0 * kPi * (1.0 - cos_all)) : 0.0);
+  const double falloff = spot ? (in_all ? spot_falloff(*spot, dot(p.w, spot->direction)) : 0.0) : 1.0;
+  const double aim = 2.0 * kPi * (1.0 - cos_aim);  // emit's solid angle
+  p.power = intensity * (aim / n);
+  p.weight = pdf > 0.0 ? falloff / (pdf * aim) : 0.0;
+  return p;
+}
+
+}  // namespace
+
+Photon emit_with_surfaces(const SceneContext& ctx, size_t source, const Vec3& c, double r, double n,
+                          Rng& rng) {
+  const double u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform(), u3 = rng.uniform(),
+               u4 = rng.uniform();
+  // Behind every surface and medium along the photon's line: 2 r (emit's) past the farthest corner.
+  const Bounds& sb = ctx.surfaces.bounds();
+  double reach = 0.0;
+  if (!sb.empty())
+    for (int k = 0; k < 8; ++k)
+      reach = std::max(
+          reach, (Vec3(k & 1 ? sb.hi.x : sb.lo.x, k & 2 ? sb.hi.y : sb.lo.y, k & 4 ? sb.hi.z : sb.lo.z) - c)
+                     .length());
+  const double back = 2.0 * r + reach;
+  double area = 0.0;
+  Photon p;
+  if (source < ctx.lights.size()) {
+    const Light& light = ctx.lights[source];
+    if (const auto* d = std::get_if<DirectionalLight>(&light)) {
+      p.w = normalize(d->direction);
+      p.x = plane_point(ctx, c, p.w, r, back, u0, u3, u4, &area);
+      p.power = d->irradiance * (kPi * r * r / n);  // emit's, over the weight area / (pi r^2)
+      p.weight = area / (kPi * r * r);
+      return p;
+    }
+    const auto* pt = std::get_if<PointLight>(&light);
+    const auto* spot = std::get_if<SpotLight>(&light);
+    const Vec3 x = pt ? pt->position : spot ? spot->position : Vec3(0.0);
+    const double dist = (c - x).length();
+    const double cos_aim = dist > r ? std::sqrt(std::max(0.0, 1.0 - r * r / (dist * dist))) : -1.0;
+    const double cos_spot = spot ? std::cos(0.5 * spot->cone_angle_deg * kPi / 180.0) : -1.0;
+    if (!(pt || spot) || dist <= r || cos_spot > cos_aim) return emit(ctx, source, c, r, n, rng);
+    return point_with_surfaces(x, (c - x) / dist, cos_aim, spot, pt ? pt->intensity : spot->intensity, n, u0,
+                               u1, u2);
+  }
+  // The environment: its direction as emit draws it, then a point of the plane.
+  double pdf = 1.0 / (4.0 * kPi);
+  Rgb radiance = ctx.environment;
+  if (ctx.env_map) {
+    const Vec3 wi = env_photon_direction(ctx, u1, u2, &pdf);
+    p.w = -wi;
+    radiance = ctx.environment_radiance(wi);
+  } else {
+    p.w = spherical_direction(1.0 - 2.0 * u1, 2.0 * kPi * u2, Vec3(0, 0, 1));
+  }
+  p.x = plane_point(ctx, c, p.w, r, back, u0, u3, u4, &area);
+  p.power = pdf > 0.0 ? radiance * (kPi * r * r / (pdf * n)) : Rgb(0.0);
+  p.weight = area / (kPi * r * r);
   return p;
 }
 

@@ -316,6 +316,7 @@ struct ScatterPhotons {
   void split(int photons);  // first = photon_split(..., photons, ...)
   void trace(size_t j, Rng& rng, PhotonBatch& batch) const;
   bool reflect(const SurfaceHit& hit, Vec3* w, int c, double* weight, int* order, Rng& rng) const;
+  bool bounce(const SurfaceHit& hit, Vec3* w, double* factor, Rng& rng) const;
   bool scatter(const Vec3& xc, Vec3* w, int c, double* weight, int* order, Rng& rng,
                PhotonBatch& batch) const;
   // The new direction after a real collision in medium m (weighted and survived); false ends the photon.
@@ -345,8 +346,9 @@ void ScatterPhotons::trace(size_t j, Rng& rng, PhotonBatch& batch) const {
   const bool light_like = source < ctx.lights.size() || (source == ctx.lights.size() && ctx.env_map);
   const int first_order = light_like && !from_media ? 1 : 0;
   const int c = pass;  // the channel whose coefficients drive this photon
-  const Photon ph =
-      from_media ? emit_from_media(*emission, ctx.media, n, rng) : emit(ctx, source, centre, radius, n, rng);
+  const Photon ph = from_media             ? emit_from_media(*emission, ctx.media, n, rng)
+                    : ctx.surfaces.empty() ? emit(ctx, source, centre, radius, n, rng)
+                                           : emit_with_surfaces(ctx, source, centre, radius, n, rng);
   const SourceBlock& sb = blocks[src];
   const TallyBlock block{.mono = sb.offset >= 0 ? batch.tally.data() + sb.offset : nullptr,
                          .colour = sb.colour,
@@ -367,8 +369,8 @@ void ScatterPhotons::trace(size_t j, Rng& rng, PhotonBatch& batch) const {
   if (!grey)
     for (int k = 0; k < 3; ++k)
       if (k != c) power[k] = 0.0;
-  if (max_component(power) <= 0.0) return;
-  double weight = 1.0;
+  if (max_component(power) <= 0.0 || !(ph.weight > 0.0)) return;
+  double weight = ph.weight;
   int order = 0;  // wide scatters so far
   walk_photon(
       ctx, s.majorants ? *s.majorants : ctx.majorants, ph.x, ph.w, majorant_scale, rng, &batch.collisions,
@@ -381,20 +383,43 @@ void ScatterPhotons::trace(size_t j, Rng& rng, PhotonBatch& batch) const {
       [&](const SurfaceHit& hit, Vec3* w) { return reflect(hit, w, c, &weight, &order, rng); });
 }
 
-// A photon of channel c meets a surface: a diffuse one reflects it (a wide scatter: its albedo as
-// weight, with roulette, a cosine-distributed direction on the side it came from); a holdout absorbs it.
+// A diffuse reflection's new direction from a mixture: with probability kTowardMedia uniform in the cone of
+// the media's sphere (from outside it), else cosine-weighted. *factor: the BRDF's cos / pi over the
+// mixture's density (times the albedo, the photon's weight). Most of the light a wide ground reflects
+// misses the media; the cone sends half of it their way (a photon of emit_with_surfaces' far plane
+// reaches them at all only so). False: the direction is below the surface.
+bool ScatterPhotons::bounce(const SurfaceHit& hit, Vec3* w, double* factor, Rng& rng) const {
+  constexpr double kTowardMedia = 0.5;
+  const Vec3 to_c = centre - hit.p;
+  const double dist = to_c.length();
+  const double toward = dist > radius ? kTowardMedia : 0.0;
+  const double cos_max =
+      toward > 0.0 ? std::sqrt(std::max(0.0, 1.0 - radius * radius / (dist * dist))) : -1.0;
+  const Vec3 axis = toward > 0.0 ? to_c / dist : hit.ns;
+  const double v0 = rng.uniform(), v1 = rng.uniform(), v2 = rng.uniform();
+  *w = v0 < toward ? spherical_direction(1.0 - v1 * (1.0 - cos_max), 2.0 * kPi * v2, axis)
+                   : cosine_direction(hit.ns, v1, v2);
+  const double cos_n = dot(*w, hit.ns);
+  if (!(cos_n > 0.0) || !(dot(*w, hit.ng) > 0.0)) return false;
+  const bool in_cone = toward > 0.0 && dot(*w, axis) >= cos_max;
+  const double pdf = (1.0 - toward) * cos_n / kPi + (in_cone ? toward / (2.0 * kPi * (1.0 - cos_max)) : 0.0);
+  *factor = (cos_n / kPi) / pdf;
+  return true;
+}
+
+// A photon of channel c meets a surface: a diffuse one reflects it (a wide scatter: its albedo times
+// bounce's factor as weight, with roulette, a direction on the side it came from); a holdout absorbs it.
 bool ScatterPhotons::reflect(const SurfaceHit& hit, Vec3* w, int c, double* weight, int* order,
                              Rng& rng) const {
   const auto* diffuse = std::get_if<DiffuseMaterial>(&ctx.surfaces.material(hit.surface));
-  if (!diffuse || ++*order >= K) return false;
-  *weight *= diffuse->albedo[c];
+  double factor = 0.0;
+  if (!diffuse || ++*order >= K || !bounce(hit, w, &factor, rng)) return false;
+  *weight *= diffuse->albedo[c] * factor;
   if (*weight < 0.1) {
     if (rng.uniform() * 0.1 >= *weight) return false;
     *weight = 0.1;
   }
-  const double v1 = rng.uniform(), v2 = rng.uniform();
-  *w = cosine_direction(hit.ns, v1, v2);
-  return dot(*w, hit.ng) > 0.0;
+  return true;
 }
 
 // A real collision at xc of a photon of channel c: albedo weight, roulette, medium, direction.
@@ -407,8 +432,8 @@ bool ScatterPhotons::scatter(const Vec3& xc, Vec3* w, int c, double* weight, int
       mp, ctx.media.count(), c, [&](int i) { return s.exact_transport ? 1.0 : 1.0 - peak_fraction[i]; });
   const double sigma = mp.sigma_a[c] + shares.sum;
   if (!(shares.sum > 0.0) || !(sigma > 0.0)) return false;
+  NIMBUS_DCHECK(shares.sum / sigma <= 1.0 + 1e-12);  // an albedo, in [0, 1]
   *weight *= shares.sum / sigma;
-  NIMBUS_DCHECK(*weight >= 0.0 && *weight <= 1.0);  // the albedo shares.sum / sigma is in [0, 1]
   if (*weight < 0.1) {
     if (rng.uniform() * 0.1 >= *weight) return false;
     *weight = 0.1;
@@ -448,8 +473,8 @@ bool ScatterPhotons::turn(int m, Vec3* w, int* order, Rng& rng, PhotonBatch& bat
 void ScatterPhotons::trace_hero(const Photon& ph, int hero, const Rgb& share, const TallyBlock& block,
                                 int first_order, CornerUniforms* corners, Rng& rng,
                                 PhotonBatch& batch) const {
-  if (max_component(ph.power) <= 0.0 || !(share[hero] > 0.0)) return;
-  HeroWalk walk{.c = hero, .a = share, .beta = Rgb(1.0), .r = Rgb(1.0), .sigma = Rgb(0.0)};
+  if (max_component(ph.power) <= 0.0 || !(ph.weight > 0.0) || !(share[hero] > 0.0)) return;
+  HeroWalk walk{.c = hero, .a = share, .beta = Rgb(ph.weight), .r = Rgb(1.0), .sigma = Rgb(0.0)};
   int order = 0;  // wide scatters so far
   // A flight's track at distance t is weighted by the null collisions before t only: each null
   // collision ends a segment, deposited with the weight it had (weighting the whole flight by the
@@ -486,14 +511,12 @@ void ScatterPhotons::trace_hero(const Photon& ph, int hero, const Rgb& share, co
         return true;
       },
       [&](const SurfaceHit& hit, Vec3* w) {
-        // A diffuse surface: a wide scatter weighted by its albedo per channel (as reflect).
+        // A diffuse surface: a wide scatter weighted by its albedo per channel (as reflect, bounce).
         const auto* diffuse = std::get_if<DiffuseMaterial>(&ctx.surfaces.material(hit.surface));
-        if (!diffuse || ++order >= K) return false;
-        walk.beta = walk.beta * diffuse->albedo;
+        double factor = 0.0;
+        if (!diffuse || ++order >= K || !bounce(hit, w, &factor, rng)) return false;
+        walk.beta = walk.beta * diffuse->albedo * factor;
         if (!walk.roulette(rng)) return false;
-        const double v1 = rng.uniform(), v2 = rng.uniform();
-        *w = cosine_direction(hit.ns, v1, v2);
-        if (!(dot(*w, hit.ng) > 0.0)) return false;
         seg = SceneSurfaces::offset(hit, *w), dir = *w;  // where walk_photon's next flight starts
         return true;
       });
