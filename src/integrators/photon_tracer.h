@@ -49,19 +49,18 @@ struct Photon {
 Photon emit(const SceneContext& ctx, size_t source, const Vec3& c, double r, double n, Rng& rng,
             const double* strat = nullptr);
 
-// emit for a scene with surfaces: the light's photons also reach the media by way of the surfaces (the sunlit
-// ground under a cloud lights its base; emit's photons, all aimed at the media's sphere, land only in the
-// media's own shadow). With probability kAimedShare a photon is emit's; otherwise a directional light's or
-// the environment's photon crosses the plane through c normal to its direction at distance rho from c with
-// density h / (2 pi (h^2 + rho^2)^(3/2)) over the whole plane, h the distance from c along the photon's
-// direction to the first surface (at least r): the light a diffuse ground h away sends into the media
-// falls off so (their solid angle times the cosine at the ground), so the photons' weights times what
-// they bring stay bounded. A point light's
-// photon goes in a uniform direction, a spot's into a uniform direction of its cone. The power is over the
-// mixture's density (as a weight over emit's power), and every photon starts behind the surfaces' and the
-// media's bounds along its line.
-// Area lights (whose photons already leave in every direction) and spots whose cone is the narrower are
-// emit's. Consumes 5 uniform numbers.
+// emit for a scene with surfaces: the light's photons also reach the media by way of the surfaces (the
+// sunlit ground under a cloud lights its base; emit's photons, all aimed at the media's sphere, land only
+// in the media's own shadow). With probability kAimedShare a photon is emit's; otherwise a directional
+// light's or the environment's photon crosses the plane through c normal to its direction at distance rho
+// from c with density h / (2 pi (h^2 + rho^2)^(3/2)) over the whole plane, h the distance from c along
+// the photon's direction to the first surface (at least r): the light a diffuse ground h away sends into
+// the media falls off so (their solid angle times the cosine at the ground), so the photons' weights times
+// what they bring stay bounded. A point light's photon goes in a uniform direction, a spot's into a
+// uniform direction of its cone. The power is over the mixture's density (as a starting weight over
+// emit's power), and every photon starts behind the surfaces' and the media's bounds along its line. Area
+// lights (whose photons already leave in every direction) and spots whose cone is the narrower are emit's.
+// Consumes 5 uniform numbers (then emit's 4 where it falls back to emit).
 inline constexpr double kAimedShare = 0.75;
 Photon emit_with_surfaces(const SceneContext& ctx, size_t source, const Vec3& c, double r, double n,
                           Rng& rng);
