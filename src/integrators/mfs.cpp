@@ -514,8 +514,11 @@ void MfsIntegrator::exact_light_transmittance(const Vec3& p, const LightSample& 
 LightBeam MfsIntegrator::light_beam(size_t l, int i, const Vec3& p, const LightSample& ls,
                                     const TrilinearStencil* st) const {
   Rgb T_light, T_wide;
-  if (is_area_light(ctx_.lights[l])) {  // an area light: march to its sampled point instead of a map
-    marched_full_and_reduced(ctx_, p, ls.wi, ls.distance, kSurfaceShadowStep, f_, &T_light, &T_wide);
+  if (is_area_light(ctx_.lights[l])) {
+    // An area light: to its sampled point instead of a map, by the chord where there is one in closed
+    // form (one constant-density sphere or box), else marched.
+    if (!chord_full_and_reduced(ctx_, p, ls.wi, ls.distance, f_, &T_light, &T_wide))
+      marched_full_and_reduced(ctx_, p, ls.wi, ls.distance, kSurfaceShadowStep, f_, &T_light, &T_wide);
     if (!s_.forward_light_path()) T_wide = T_light;
   } else if (*s_.exact_light_transmittance) {
     exact_light_transmittance(p, ls, &T_light, &T_wide);
