@@ -22,17 +22,20 @@ constexpr double kHeight = 2.0;  // of the medium's centre over the ground
 constexpr double kHalf = 60.0;   // the ground's half size
 constexpr double kAlbedo = 0.5;  // the ground's
 
-Scene ground_scene(const std::string& light) {
+Scene ground_scene(const std::string& light, const std::string& sigma_s = "0.005",
+                   const std::string& albedo = "0.5") {
   return test::scene_from_json("{" + test::camera_json(8, 8, 40.0) + R"(,
-    "media": [{"shape": {"type": "sphere", "center": [0, 0, 2], "radius": 0.5}, "sigma_s": 0.005,
+    "media": [{"shape": {"type": "sphere", "center": [0, 0, 2], "radius": 0.5}, "sigma_s": )" +
+                               sigma_s + R"(,
                "sigma_a": 0.0, "phase": {"type": "isotropic"}}],
     "surfaces": [{"shape": {"type": "rectangle", "center": [0, 0, 0], "normal": [0, 0, 1], "up": [0, 1, 0],
-                  "size": [120, 120]}, "material": {"type": "diffuse", "albedo": 0.5}}],
+                  "size": [120, 120]}, "material": {"type": "diffuse", "albedo": )" +
+                               albedo + R"(}}],
     "lights": [)" + light + "]}");
 }
 
 // The grid's fluence (integral of the radiance over directions) at the medium's centre, for `seed`.
-double grid_fluence(const SceneContext& ctx, uint64_t seed) {
+Rgb grid_fluence_rgb(const SceneContext& ctx, uint64_t seed) {
   const Phase& phase = ctx.media.phase(0);
   const PhaseSplit split(phase, auto_peak_fraction(phase));
   ScatterGridSettings s;
@@ -42,8 +45,9 @@ double grid_fluence(const SceneContext& ctx, uint64_t seed) {
   const ScatterGrid grid(ctx, {&split}, {split.f()}, s);
   // An isotropic phase function's moments (1, 0, 0): the radiance scattered is the fluence / 4 pi.
   const std::array<Rgb, kShMaxBands> chi = {Rgb(1.0), Rgb(0.0), Rgb(0.0)};
-  return 4.0 * kPi * luminance(grid.scattered(Vec3(0, 0, kHeight), Vec3(0, 0, 1), chi));
+  return grid.scattered(Vec3(0, 0, kHeight), Vec3(0, 0, 1), chi) * (4.0 * kPi);
 }
+double grid_fluence(const SceneContext& ctx, uint64_t seed) { return luminance(grid_fluence_rgb(ctx, seed)); }
 
 // The solid angle of the ground (a kHalf square) from kHeight above its centre.
 double ground_solid_angle() { return 4.0 * std::asin(kHalf * kHalf / (kHalf * kHalf + kHeight * kHeight)); }
@@ -86,6 +90,27 @@ TEST(GroundBounce, SunlitGroundLightsTheMediumAbove) {
   const double bounce = kAlbedo * 2.0 / kPi * ground_solid_angle();
   expect_fluence(R"({"type": "directional", "direction": [0, 0, -1], "irradiance": 2.0})", bounce,
                  2.0 + bounce);
+}
+
+// A chromatic medium over a coloured ground: the medium's photons walk with hero channels (ScatterPhotons'
+// HeroWalk), which start with the far plane's weights too; each channel as the grey sun's, with that
+// channel's albedo and scattering.
+TEST(GroundBounce, ChromaticMediumOverAColouredGroundKeepsEachChannel) {
+  const Scene scene = ground_scene(R"({"type": "directional", "direction": [0, 0, -1], "irradiance": 2.0})",
+                                   "[0.004, 0.005, 0.006]", "[0.3, 0.5, 0.7]");
+  const SceneContext ctx(scene);
+  const Rgb albedo(0.3, 0.5, 0.7), sigma_s(0.004, 0.005, 0.006);
+  constexpr int kSeeds = 8;
+  Rgb v[kSeeds], mean(0.0), var(0.0);
+  for (int i = 0; i < kSeeds; ++i) mean += (v[i] = grid_fluence_rgb(ctx, uint64_t(i + 1))) * (1.0 / kSeeds);
+  for (const Rgb& x : v) var += (x - mean) * (x - mean) * (1.0 / (kSeeds - 1));
+  for (int c = 0; c < 3; ++c) {
+    const double bounce = albedo[c] * 2.0 / kPi * ground_solid_angle();
+    const double exact = bounce + sigma_s[c] * 0.5 * (2.0 + bounce), se = std::sqrt(var[c] / kSeeds);
+    std::printf("channel %d: grid %.5f +- %.5f, exact %.5f\n", c, mean[c], se, exact);
+    EXPECT_LT(se, 0.03 * exact) << c;
+    EXPECT_NEAR(mean[c], exact, 4.0 * se + 0.01 * exact) << c;
+  }
 }
 
 // A uniform sky: its own light from every direction the ground leaves open (the environment's photons
