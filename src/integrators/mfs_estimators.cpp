@@ -161,8 +161,9 @@ LightBeam peak_only_beam(const Rgb& T_light, const Rgb& T_wide, bool traced, con
     if (!traced && lengthening && b.T_wide[c] > 0.0)
       b.T_wide[c] *= path_lengthening(theta2 * b.tau_ps[c], -std::log(b.T_wide[c]));
   }
-  // eq. D9: the traced beam's loss R (its lengthened paths included: no eq. D5).
-  if (traced) b.T_wide *= R;
+  // eq. D9: the traced beam's loss R (its lengthened paths included: no eq. D5), bounded (header).
+  if (traced)
+    for (int c = 0; c < 3; ++c) b.T_wide[c] = std::min(b.T_wide[c] * R[c], kMaxPeakTransmittance);
   return b;
 }
 

@@ -111,7 +111,15 @@ struct LightBeam {
 // R, and with mean_cos the spread from the beam's mean cosine, eq. D9; without it, or not traced, the
 // straight beam's peak depth ln(T_wide / T_light), eq. D8); peak_moments: the medium's chi_l^peak;
 // theta2: its peak's mean square angle. path_lengthening (forward light path only) applies eq. D5 to the
-// straight beam.
+// straight beam. The traced beam's T_wide R is at most kMaxPeakTransmittance (see there).
+//
+// kMaxPeakTransmittance: the peak-only light, relative to the light's unattenuated beam, exceeds 1 only
+// by its paths' lengthening (1 / cos of its spread): at most 1.16-1.34 on the suite's spheres and the
+// Disney cloud. R = traced / straight is a ratio of two tallies, and in a medium of thin dense filaments
+// (the smoke plume) a node's straight tally can be nearly empty: its photons' midpoint-rule loss fell
+// far below the shadow map's where a deposit sample hit a dense voxel. R then reached 10^6 and T_wide R
+// 10^5 (fireflies of 400x the pixel around them). The bound changes no image of the suite.
+inline constexpr double kMaxPeakTransmittance = 2.0;
 LightBeam peak_only_beam(const Rgb& T_light, const Rgb& T_wide, bool traced, const Rgb& R,
                          const Rgb* mean_cos, const std::vector<double>& peak_moments, double theta2,
                          bool path_lengthening);

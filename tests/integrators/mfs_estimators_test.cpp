@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/rng.h"
@@ -182,6 +183,20 @@ TEST(MfsEstimators, PeakOnlyBeamDepths) {  // eqs. D8, D9
     EXPECT_EQ(st.tau_ps[c], s.tau_ps[c]);
     EXPECT_DOUBLE_EQ(st.T_wide[c], R[c] * T_wide[c]);
   }
+}
+
+// The traced beam's T_wide R is bounded by kMaxPeakTransmittance (a nearly empty straight tally gave R ~
+// 10^6 in the smoke plume), per channel; below the bound R multiplies as before, bit for bit.
+TEST(MfsEstimators, TracedPeakTransmittanceIsBounded) {
+  const std::vector<double> chi_p = {1.0, 0.9, 0.75};
+  const Rgb T_light(0.01, 0.2, 0.3), T_wide(0.05, 0.4, 0.9);
+  const Rgb R(2.0e6, 1.3, 2.0);  // channel 0: a failed ratio; 1: lengthened paths; 2: 1.8 > the bound
+  const LightBeam b = peak_only_beam(T_light, T_wide, true, R, nullptr, chi_p, 0.05, false);
+  EXPECT_EQ(b.T_wide[0], kMaxPeakTransmittance);
+  EXPECT_EQ(b.T_wide[1], T_wide[1] * R[1]);
+  EXPECT_EQ(b.T_wide[2], std::min(T_wide[2] * R[2], kMaxPeakTransmittance));
+  EXPECT_GT(T_wide[2] * R[2], 1.0);  // channel 2 is above 1 and kept: the bound is not at 1
+  EXPECT_LT(kMaxPeakTransmittance, 10.0);
 }
 
 TEST(MfsEstimators, PeakDepthsAddInTheMoments) {  // eqs. D3, D4, D12
