@@ -14,6 +14,21 @@
 
 namespace nimbus {
 
+namespace {
+
+// A point or spot light at x and the media's sphere (c, r): the distance to c, the cone towards the sphere
+// (cos_aim; -1 from inside it) and a spot's own cone (cos_spot; -1 for a point light).
+struct LightCones {
+  double dist, cos_aim, cos_spot;
+};
+LightCones light_cones(const Vec3& x, const SpotLight* spot, const Vec3& c, double r) {
+  const double dist = (c - x).length();
+  return {dist, dist > r ? std::sqrt(std::max(0.0, 1.0 - r * r / (dist * dist))) : -1.0,
+          spot ? std::cos(0.5 * spot->cone_angle_deg * kPi / 180.0) : -1.0};
+}
+
+}  // namespace
+
 Photon emit(const SceneContext& ctx, size_t source, const Vec3& c, double r, double n, Rng& rng,
             const double* strat) {
   double u1 = rng.uniform(), u2 = rng.uniform(), u3 = rng.uniform(), u4 = rng.uniform();
@@ -37,11 +52,9 @@ Photon emit(const SceneContext& ctx, size_t source, const Vec3& c, double r, dou
       const auto* spot = std::get_if<SpotLight>(&light);
       p.x = pt ? pt->position : spot->position;
       const Vec3 v = c - p.x;
-      const double dist = v.length();
       // The narrower of the cone towards the media's sphere and a spot's own cone (both hold every
       // direction that carries power into the media).
-      const double cos_aim = dist > r ? std::sqrt(std::max(0.0, 1.0 - r * r / (dist * dist))) : -1.0;
-      const double cos_spot = spot ? std::cos(0.5 * spot->cone_angle_deg * kPi / 180.0) : -1.0;
+      const auto [dist, cos_aim, cos_spot] = light_cones(p.x, spot, c, r);
       if (cos_spot > cos_aim) {
         p.w = spherical_direction(1.0 - u1 * (1.0 - cos_spot), 2.0 * kPi * u2, spot->direction);
         p.power = Rgb(2.0 * kPi * (1.0 - cos_spot) / n);
@@ -99,10 +112,10 @@ Vec3 plane_point(const SceneContext& ctx, const Vec3& c, const Vec3& w, double r
 
 // A point or spot light's photon of emit_with_surfaces: the cone towards the media's sphere (cos_aim) with
 // probability kAimedShare, else a uniform direction of the light's whole range (a sphere, or the spot's
-// cone cos_spot); the power over the mixture's density.
-Photon point_with_surfaces(const Vec3& x, const Vec3& to_c, double cos_aim, const SpotLight* spot,
-                           const Rgb& intensity, double n, double u0, double u1, double u2) {
-  const double cos_all = spot ? std::cos(0.5 * spot->cone_angle_deg * kPi / 180.0) : -1.0;
+// cone cos_all = light_cones' cos_spot); the power over the mixture's density.
+Photon point_with_surfaces(const Vec3& x, const Vec3& to_c, double cos_aim, double cos_all,
+                           const SpotLight* spot, const Rgb& intensity, double n, double u0, double u1,
+                           double u2) {
   const Vec3 axis_all = spot ? spot->direction : Vec3(0, 0, 1);
   Photon p;
   p.x = x;
@@ -121,11 +134,7 @@ Photon point_with_surfaces(const Vec3& x, const Vec3& to_c, double cos_aim, cons
 
 }  // namespace
 
-Photon emit_with_surfaces(const SceneContext& ctx, size_t source, const Vec3& c, double r, double n,
-                          Rng& rng) {
-  const double u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform(), u3 = rng.uniform(),
-               u4 = rng.uniform();
-  // Behind every surface and medium along the photon's line: 2 r (emit's) past the farthest corner.
+double photon_start_distance(const SceneContext& ctx, const Vec3& c, double r) {
   const Bounds& sb = ctx.surfaces.bounds();
   double reach = 0.0;
   if (!sb.empty())
@@ -133,7 +142,13 @@ Photon emit_with_surfaces(const SceneContext& ctx, size_t source, const Vec3& c,
       reach = std::max(
           reach, (Vec3(k & 1 ? sb.hi.x : sb.lo.x, k & 2 ? sb.hi.y : sb.lo.y, k & 4 ? sb.hi.z : sb.lo.z) - c)
                      .length());
-  const double back = 2.0 * r + reach;
+  return 2.0 * r + reach;
+}
+
+Photon emit_with_surfaces(const SceneContext& ctx, size_t source, const Vec3& c, double r, double back,
+                          double n, Rng& rng) {
+  const double u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform(), u3 = rng.uniform(),
+               u4 = rng.uniform();
   double area = 0.0;
   Photon p;
   if (source < ctx.lights.size()) {
@@ -147,13 +162,12 @@ Photon emit_with_surfaces(const SceneContext& ctx, size_t source, const Vec3& c,
     }
     const auto* pt = std::get_if<PointLight>(&light);
     const auto* spot = std::get_if<SpotLight>(&light);
-    const Vec3 x = pt ? pt->position : spot ? spot->position : Vec3(0.0);
-    const double dist = (c - x).length();
-    const double cos_aim = dist > r ? std::sqrt(std::max(0.0, 1.0 - r * r / (dist * dist))) : -1.0;
-    const double cos_spot = spot ? std::cos(0.5 * spot->cone_angle_deg * kPi / 180.0) : -1.0;
-    if (!(pt || spot) || dist <= r || cos_spot > cos_aim) return emit(ctx, source, c, r, n, rng);
-    return point_with_surfaces(x, (c - x) / dist, cos_aim, spot, pt ? pt->intensity : spot->intensity, n, u0,
-                               u1, u2);
+    if (!(pt || spot)) return emit(ctx, source, c, r, n, rng);
+    const Vec3 x = pt ? pt->position : spot->position;
+    const auto [dist, cos_aim, cos_spot] = light_cones(x, spot, c, r);
+    if (dist <= r || cos_spot > cos_aim) return emit(ctx, source, c, r, n, rng);
+    return point_with_surfaces(x, (c - x) / dist, cos_aim, cos_spot, spot,
+                               pt ? pt->intensity : spot->intensity, n, u0, u1, u2);
   }
   // The environment: its direction as emit draws it, then a point of the plane.
   double pdf = 1.0 / (4.0 * kPi);

@@ -58,12 +58,16 @@ Photon emit(const SceneContext& ctx, size_t source, const Vec3& c, double r, dou
 // the media falls off so (their solid angle times the cosine at the ground), so the photons' weights times
 // what they bring stay bounded. A point light's photon goes in a uniform direction, a spot's into a
 // uniform direction of its cone. The power is over the mixture's density (as a starting weight over
-// emit's power), and every photon starts behind the surfaces' and the media's bounds along its line. Area
+// emit's power), and every photon starts `back` behind the plane along its line (photon_start_distance:
+// behind the surfaces' and the media's bounds). Area
 // lights (whose photons already leave in every direction) and spots whose cone is the narrower are emit's.
 // Consumes 5 uniform numbers (then emit's 4 where it falls back to emit).
 inline constexpr double kAimedShare = 0.75;
-Photon emit_with_surfaces(const SceneContext& ctx, size_t source, const Vec3& c, double r, double n,
-                          Rng& rng);
+Photon emit_with_surfaces(const SceneContext& ctx, size_t source, const Vec3& c, double r, double back,
+                          double n, Rng& rng);
+// How far behind the plane through c emit_with_surfaces' photons start: emit's 2 r past the farthest
+// corner of the surfaces' bounds (once per grid, not per photon).
+double photon_start_distance(const SceneContext& ctx, const Vec3& c, double r);
 // True when every medium's sigma_s and sigma_a are equal in all channels (one photon pass carries RGB).
 bool grey_media(const SceneContext& ctx);
 
