@@ -366,15 +366,16 @@ bool BeamPhotons::scatter(const Vec3& xc, Vec3* w, BeamWalk& walk, Rng& rng, Pho
 
 BeamGrid::BeamGrid(const SceneContext& ctx, const std::vector<const PhaseSplit*>& splits,
                    const std::vector<double>& peak_fraction, const std::vector<TransmittanceGrid>& full_maps,
-                   const std::vector<TransmittanceGrid>& reduced_maps, int photons, int resolution,
-                   uint64_t seed, bool spread, const Vec3* camera, const MajorantGrid* majorants,
-                   bool skip_idle)
+                   const std::vector<TransmittanceGrid>& reduced_maps, const std::vector<int>& photons,
+                   int resolution, uint64_t seed, bool spread, const Vec3* camera,
+                   const MajorantGrid* majorants, bool skip_idle)
     : with_camera_(camera != nullptr), spread_(spread) {
   if (camera) camera_ = *camera;
   values_.resize(ctx.lights.size());
   const Bounds media_bounds = ctx.media.bounds();
-  if (media_bounds.empty() || photons <= 0 || reduced_maps.size() != ctx.lights.size() ||
-      full_maps.size() != ctx.lights.size() || splits.empty())
+  if (media_bounds.empty() || photons.size() != ctx.lights.size() ||
+      std::none_of(photons.begin(), photons.end(), [](int n) { return n > 0; }) ||
+      reduced_maps.size() != ctx.lights.size() || full_maps.size() != ctx.lights.size() || splits.empty())
     return;
   one_minus_chi1_ = 1.0 - (splits[0]->peak_moments().size() > 1 ? splits[0]->peak_moments()[1] : 1.0);
   grid_ = node_grid_padded(media_bounds, resolution);
@@ -382,15 +383,9 @@ BeamGrid::BeamGrid(const SceneContext& ctx, const std::vector<const PhaseSplit*>
   channels_ = grey && grey_lights(ctx) ? 1 : 3;
   const Blocks blocks{.spread = spread, .pk = camera != nullptr};
   stride_ = channels_ * blocks.count();
-  // Chromatic media: one pass per channel, the light's photons shared among them (a third each: the
-  // suite's chromatic box had the same error with a third as with all three times over, at 0.8x the
-  // set-up; docs/benchmarks.md).
-  const size_t per_pass = grey ? size_t(photons) : std::max<size_t>(1, (size_t(photons) + 2) / 3);
-  const size_t total = size_t(grey ? 1 : 3) * per_pass;
   const Vec3 centre = (media_bounds.lo + media_bounds.hi) * 0.5;
   // Photons cover the whole node grid (its padding included), so every node's estimate is complete.
   const double radius = 0.5 * (grid_.bounds.hi - grid_.bounds.lo).length() * (1.0 + 1e-9) + 1e-12;
-
   std::vector<uint8_t> idle = idle_cells(grid_, ctx.majorants);
   if (!skip_idle) std::fill(idle.begin(), idle.end(), uint8_t(0));
   idle_share_ = double(std::count(idle.begin(), idle.end(), uint8_t(1))) / double(idle.size());
@@ -399,7 +394,12 @@ BeamGrid::BeamGrid(const SceneContext& ctx, const std::vector<const PhaseSplit*>
     const Light& light = ctx.lights[l];
     const auto* dir = std::get_if<DirectionalLight>(&light);
     const auto* point = std::get_if<PointLight>(&light);
-    if (!dir && !point) continue;
+    if ((!dir && !point) || photons[l] <= 0) continue;
+    // Chromatic media: one pass per channel, the light's photons shared among them (a third each: the
+    // suite's chromatic box had the same error with a third as with all three times over, at 0.8x the
+    // set-up; docs/benchmarks.md).
+    const size_t per_pass = grey ? size_t(photons[l]) : std::max<size_t>(1, (size_t(photons[l]) + 2) / 3);
+    const size_t total = size_t(grey ? 1 : 3) * per_pass;
     const BeamPhotons beam{.ctx = ctx,
                            .splits = splits,
                            .peak_fraction = peak_fraction,

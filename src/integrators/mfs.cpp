@@ -11,179 +11,13 @@
 #include "integrators/camera_layers.h"
 #include "integrators/env_light.h"
 #include "integrators/mfs_estimators.h"
+#include "integrators/mfs_settings.h"
 #include "integrators/surface_light.h"
 #include "integrators/tracking.h"
 #include "media/density_grid.h"
 #include "nimbus/error.h"
 
 namespace nimbus {
-
-namespace {
-const std::vector<std::string> kLightPathNames = {"forward", "beer_lambert"};
-const std::vector<std::string> kBeamSpreadNames = {"straight", "traced"};  // as BeamSpread
-const std::vector<std::string> kPropagatorNames = {"gsa", "gaussian"};
-const std::vector<std::string> kPhotonTransportNames = {"exact", "similarity"};
-const std::vector<std::string> kForwardSideNames = {"camera", "light"};
-const std::vector<std::string> kSplatNames = {"trilinear", "stochastic", "stratified"};  // as Splat
-}  // namespace
-
-MfsSettings mfs_settings_from_json(const nlohmann::json& options, const std::string& where) {
-  MfsSettings s;
-  JsonObject o(options, where, "/integrator");
-  s.tau_step = o.number("tau_step", 1e-4, 100.0, s.tau_step);
-  s.step_growth = o.number("step_growth", 0.0, 100.0, s.step_growth);
-  s.light_path = LightPath(o.choice("light_path", kLightPathNames, int(s.light_path)));
-  s.propagator = Propagator(o.choice("propagator", kPropagatorNames, int(s.propagator)));
-  if (double f = 0.0; o.keyword_or_number("peak_fraction", "auto", 0.0, 0.99, &f)) s.peak_fraction = f;
-  if (int64_t k = 0; o.keyword_or_integer("large_angle_scatters", "all", 0, 1024, &k))
-    s.large_angle_scatters = int(k);
-  if (int64_t n = 0; o.keyword_or_integer("photons", "auto", 1, 1 << 26, &n)) s.photons = int(n);
-  s.photon_transport =
-      PhotonTransport(o.choice("photon_transport", kPhotonTransportNames, int(s.photon_transport)));
-  s.channel_passes = o.boolean("channel_passes", s.channel_passes);
-  if (int64_t n = 0; o.keyword_or_integer("scatter_grid_resolution", "auto", 4, 96, &n))
-    s.scatter_grid_resolution = int(n);
-  s.scatter_grid_bands = int(o.integer("scatter_grid_bands", 1, kShMaxBands, s.scatter_grid_bands));
-  s.forward_side = ForwardSide(o.choice("forward_side", kForwardSideNames, int(s.forward_side)));
-  s.beam_photons = int(o.integer("beam_photons", 0, 1 << 24, s.beam_photons));
-  s.beam_spread = BeamSpread(o.choice("beam_spread", kBeamSpreadNames, int(s.beam_spread)));
-  s.photon_splat = Splat(o.choice("photon_splat", kSplatNames, int(s.photon_splat)));
-  s.light_blur = o.boolean("light_blur", s.light_blur);
-  s.path_lengthening = o.boolean("path_lengthening", s.path_lengthening);
-  s.filtered_lookups = o.boolean("filtered_lookups", s.filtered_lookups);
-  s.source_blur = o.boolean("source_blur", s.source_blur);
-  s.camera_tilt = o.boolean("camera_tilt", s.camera_tilt);
-  s.camera_shift = o.boolean("camera_shift", s.camera_shift);
-  s.peak_toward_camera = o.boolean("peak_toward_camera", s.peak_toward_camera);
-  if (bool b = false; o.keyword_or_boolean("exact_light_transmittance", "auto", &b))
-    s.exact_light_transmittance = b;
-  s.shadow_map_resolution = int(o.integer("shadow_map_resolution", 8, 1024, s.shadow_map_resolution));
-  s.edge_samples = int(o.integer("edge_samples", 1, kMaxEdgeSamples, s.edge_samples));
-  o.finish();
-  // The light side carries the light to every scatter through peak scatters, with photons in the true
-  // medium: other choices would be silently overridden, so they are errors.
-  if (s.light_side() && !s.forward_light_path())
-    o.fail("light_path", "\"beer_lambert\" conflicts with " + o.path_of("forward_side") +
-                             " \"light\" (the light side needs \"forward\")");
-  if (s.light_side() && s.photon_transport != PhotonTransport::exact)
-    o.fail("photon_transport", "\"similarity\" conflicts with " + o.path_of("forward_side") +
-                                   " \"light\" (the light side needs \"exact\")");
-  return s;
-}
-
-nlohmann::json to_json(const MfsSettings& s) {
-  nlohmann::json j = {{"tau_step", s.tau_step},
-                      {"step_growth", s.step_growth},
-                      {"light_path", kLightPathNames[int(s.light_path)]},
-                      {"propagator", kPropagatorNames[int(s.propagator)]},
-                      {"photon_transport", kPhotonTransportNames[int(s.photon_transport)]},
-                      {"channel_passes", s.channel_passes},
-                      {"scatter_grid_bands", s.scatter_grid_bands},
-                      {"forward_side", kForwardSideNames[int(s.forward_side)]},
-                      {"beam_photons", s.beam_photons},
-                      {"beam_spread", kBeamSpreadNames[int(s.beam_spread)]},
-                      {"photon_splat", kSplatNames[int(s.photon_splat)]},
-                      {"light_blur", s.light_blur},
-                      {"path_lengthening", s.path_lengthening},
-                      {"filtered_lookups", s.filtered_lookups},
-                      {"source_blur", s.source_blur},
-                      {"camera_tilt", s.camera_tilt},
-                      {"camera_shift", s.camera_shift},
-                      {"peak_toward_camera", s.peak_toward_camera},
-                      {"shadow_map_resolution", s.shadow_map_resolution},
-                      {"edge_samples", s.edge_samples}};
-  j["peak_fraction"] = s.peak_fraction ? nlohmann::json(*s.peak_fraction) : nlohmann::json("auto");
-  j["large_angle_scatters"] =
-      s.large_angle_scatters ? nlohmann::json(*s.large_angle_scatters) : nlohmann::json("all");
-  j["photons"] = s.photons ? nlohmann::json(*s.photons) : nlohmann::json("auto");
-  j["exact_light_transmittance"] =
-      s.exact_light_transmittance ? nlohmann::json(*s.exact_light_transmittance) : nlohmann::json("auto");
-  j["scatter_grid_resolution"] =
-      s.scatter_grid_resolution ? nlohmann::json(*s.scatter_grid_resolution) : nlohmann::json("auto");
-  return j;
-}
-
-namespace {
-
-// The photons' own majorant grid: the scene's cells with each cell's maximum taken from the voxels
-// rather than from the 8^3 bricks' maxima. On the Disney cloud it cuts the photons' density lookups by
-// 43 % (null collisions 73 % -> 53 % of them) for ~0.02 s of build (docs/benchmarks.md, issue 12). Any
-// conservative majorant leaves delta tracking exact: the grids change only by photon noise. Its build
-// reads every voxel ~3.4 times (~4 ns each) and saves ~5 lookups (~0.1 us each) per photon, so it is
-// built only while the voxels are at most 16 per photon; else (and without grid media) nullopt: the
-// photons track the scene's grid.
-std::optional<MajorantGrid> photon_majorant_grid(const SceneContext& ctx, const MfsSettings& s) {
-  double voxels = 0.0;
-  for (int i = 0; i < ctx.media.count(); ++i) {
-    const Shape& shape = ctx.media.medium(i).shape;
-    const DensityGrid* g = nullptr;
-    if (const auto* v = std::get_if<VdbShape>(&shape)) g = v->data.get();
-    if (const auto* c = std::get_if<CloudShape>(&shape)) g = c->data.get();
-    if (g) {
-      const Vec3 e = g->index_hi() - g->index_lo();
-      voxels += std::max(0.0, e.x) * std::max(0.0, e.y) * std::max(0.0, e.z);
-    }
-  }
-  const double photons = double(s.photons.value_or(0)) + double(s.beam_photons) * double(ctx.lights.size());
-  if (!(voxels > 0.0 && voxels <= 16.0 * photons)) return std::nullopt;
-  const auto r = ctx.majorants.resolution();
-  return std::optional<MajorantGrid>(std::in_place, ctx.media, std::max({r[0], r[1], r[2]}), false, true);
-}
-
-// "auto" scatter-grid resolution: cells of at most ~1.6 optical depths at the medium's typical
-// extinction (the mean of the majorant grid's non-empty cells), 32 to 64 nodes along the longest axis:
-// 32 up to an optical size of ~50 across. (A uniform medium's whole extinction; a cloud's dense core
-// counts less.)
-int auto_scatter_grid_resolution(const SceneContext& ctx) {
-  const Bounds b = ctx.media.bounds();
-  double sum = 0.0;
-  size_t cells = 0;
-  const auto res = ctx.majorants.resolution();
-  for (int z = 0; z < res[2]; ++z)
-    for (int y = 0; y < res[1]; ++y)
-      for (int x = 0; x < res[0]; ++x)
-        if (const double m = ctx.majorants.cell_majorant(x, y, z); m > 0.0) sum += m, ++cells;
-  const Vec3 e = b.empty() ? Vec3(0.0) : b.hi - b.lo;
-  const double across = cells > 0 ? std::max({e.x, e.y, e.z}) * sum / double(cells) : 0.0;
-  return std::isfinite(across) ? int(std::clamp(std::ceil(across / 1.6), 32.0, 64.0)) : 64;
-}
-
-// "auto" scatter-grid photons: 2^18 up to 128 x 128 pixels, then 2^18 sqrt(pixels / 128^2). A grid of N
-// photons costs c N of set-up and leaves a noise a / N in the error^2 beside mfs's bias b^2; the rest of the
-// render costs F (the march, growing with the pixels). (b^2 + a / N) (F + c N) is least at
-// N = sqrt(a F / (b^2 c)), so the count follows the square root of the pixels. Measured at 512 x 512
-// (docs/benchmarks.md, "Photons by image size"): 4 x 2^18 gives 0.70x error^2 x CPU on the Disney cloud and 0.56x on the
-// front-lit r = 10 sphere against 2^18. The full image's pixels, not the spp or a region's: a resumed,
-// cropped or sample-range render traces the same photons as the render in one go. The scatter grid then
-// raises this to 2^18 times a factor of its pilot's collisions per photon where that is more
-// (ScatterGridSettings::adaptive_photons).
-constexpr int kAutoPhotons = 1 << 18;
-int auto_photons(const PinholeCamera& camera) {
-  const double pixels = double(camera.width()) * double(camera.height());
-  const double n = double(kAutoPhotons) * std::sqrt(std::max(1.0, pixels / (128.0 * 128.0)));
-  return int(std::min(std::round(n), double(1 << 26)));
-}
-
-// The scatter grid's settings from mfs's (photons resolved; adaptive: they were "auto").
-ScatterGridSettings scatter_grid_settings(const MfsSettings& s, bool adaptive, uint64_t seed,
-                                          const MajorantGrid* tracking) {
-  ScatterGridSettings grid;
-  grid.photons = *s.photons;
-  grid.adaptive_photons = adaptive ? kAutoPhotons : 0;
-  grid.resolution = *s.scatter_grid_resolution;
-  grid.max_wide_scatters = s.large_angle_scatters.value_or(0);
-  grid.exact_transport = s.photon_transport == PhotonTransport::exact;
-  grid.channel_passes = s.channel_passes;
-  grid.bands = s.scatter_grid_bands;
-  grid.live_nodes_only = !s.filtered_lookups;  // the pre-filtered levels read every node
-  grid.prefiltered = s.filtered_lookups;       // only filtered lookups read them
-  grid.splat = s.photon_splat;
-  grid.seed = seed;
-  grid.majorants = tracking;
-  return grid;
-}
-
-}  // namespace
 
 MfsIntegrator::MfsIntegrator(const SceneContext& context, MfsSettings settings, uint64_t seed)
     : ctx_(context), s_(settings) {
@@ -194,22 +28,30 @@ MfsIntegrator::MfsIntegrator(const SceneContext& context, MfsSettings settings, 
     f_.push_back(splits_.back()->f());
     theta2_.push_back(splits_.back()->theta2());
   }
+  double cut_angle = 0.0;  // the widest peak's, for "auto" beam photons
+  for (const auto& sp : splits_)
+    if (sp->f() > 0.0) cut_angle = std::max(cut_angle, sp->cut_angle());
+  beam_counts_ = s_.beam_photons ? std::vector<int>(ctx_.lights.size(), *s_.beam_photons)
+                                 : auto_beam_photons(ctx_, cut_angle);
+  if (!beam_counts_.empty() &&
+      std::all_of(beam_counts_.begin(), beam_counts_.end(), [&](int n) { return n == beam_counts_[0]; }))
+    s_.beam_photons = beam_counts_[0];  // the header's settings: one count for every light, or "auto"
   // The light's chord in closed form where there is one (the maps' interpolation errs at sharp rims).
   if (!s_.exact_light_transmittance)
     s_.exact_light_transmittance = ctx_.analytic.active() && ctx_.media.count() == 1;
   build_maps();
   if (!s_.scatter_grid_resolution) s_.scatter_grid_resolution = auto_scatter_grid_resolution(ctx_);
   if (!s_.photons) s_.photons = auto_photons(ctx_.camera);
-  const std::optional<MajorantGrid> photon_majorants = photon_majorant_grid(ctx_, s_);
+  const std::optional<MajorantGrid> photon_majorants = photon_majorant_grid(ctx_, s_, beam_counts_);
   const MajorantGrid* tracking = photon_majorants ? &*photon_majorants : nullptr;
   std::vector<const PhaseSplit*> splits;  // for the photon grids
   for (const auto& sp : splits_) splits.push_back(sp.get());
-  if (s_.forward_light_path() && s_.beam_photons > 0 && !ctx_.lights.empty()) {
+  if (beam_on()) {
     // peak_toward_camera: the beam's P_peak towards the camera tallied too (one medium only).
     const Vec3 camera = ctx_.camera.origin();
     const bool toward = s_.peak_toward_camera && ctx_.media.count() == 1;
     beam_ = std::make_unique<BeamGrid>(
-        ctx_, splits, f_, full_maps_, reduced_maps_, s_.beam_photons, *s_.scatter_grid_resolution, seed,
+        ctx_, splits, f_, full_maps_, reduced_maps_, beam_counts_, *s_.scatter_grid_resolution, seed,
         s_.beam_spread == BeamSpread::traced, toward ? &camera : nullptr, tracking);
   }
   // Wide scatters 2 .. K from the scatter grid (for K = 1 only the environment's light).
@@ -241,7 +83,7 @@ void MfsIntegrator::build_maps() {
   // give the same validation errors (the map's trilinear interpolation dominates); 0.25 halves the
   // Disney cloud's precomputation against 0.05.
   constexpr double map_step = 0.25;
-  const bool beam = s_.forward_light_path() && s_.beam_photons > 0;
+  const bool beam = beam_on();
   for (const Light& l : ctx_.lights) {
     const int res = is_area_light(l) ? 8 : s_.shadow_map_resolution;  // area lights: a token map (light_beam)
     if (*s_.exact_light_transmittance) {

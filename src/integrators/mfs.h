@@ -44,7 +44,7 @@
 // | `scatter_grid_resolution` | "auto" or integer in [4, 96]  | "auto"    | scatter and beam grid nodes along the longest axis ("auto": ~1.6 optical depths per cell, 32 to 64; the header of a rendered image holds the number chosen) |
 // | `scatter_grid_bands`      | integer in [1, 3]             | 3         | spherical-harmonic bands used at lookup (l < bands) |
 // | `forward_side`            | "camera" or "light"           | "camera"  | peak scatters after the last wide scatter carried to the camera, or taken on the light's side with an exact camera leg |
-// | `beam_photons`            | integer in [0, 2^24]          | 32768     | photons per light for the peak-only beam grid, shared among the channels' passes in chromatic media (0: straight beams) |
+// | `beam_photons`            | "auto" or integer in [0, 2^24] | "auto"  | photons per light for the peak-only beam grid, shared among the channels' passes in chromatic media (0: straight beams; "auto": 2^15, and 2^15 sqrt(pixels / 128^2), at most 8 x 2^15, for a light whose forward peak the camera looks into: auto_beam_photons in mfs.cpp) |
 // | `beam_spread`             | "straight" or "traced"        | "straight" | the peak-only light's angular spread: the straight beam's peak depth ln(T_wide / T_light) (D8), or the beam grid's photons' mean cosine read against the straight beam's (D9b; backlit spheres' binned error 1.4x, docs/benchmarks.md "The beam's spread") |
 // | `photon_splat`            | "trilinear", "stochastic" or "stratified" | "trilinear" | how the scatter grid's photons deposit each track sample: over the 8 nodes around it, or whole to one of them drawn by its trilinear weight (independently, or stratified along the track); the same expected grid, more noise (the beam grid stays trilinear) |
 // | `light_blur`              | boolean                       | true      | the first wide scatter sees the beam's light-side angular spread |
@@ -100,7 +100,8 @@ struct MfsSettings {
   std::optional<int> scatter_grid_resolution;  // nullopt: "auto" (resolved by MfsIntegrator)
   int scatter_grid_bands = 3;
   ForwardSide forward_side = ForwardSide::camera;
-  int beam_photons = 1 << 15;
+  std::optional<int>
+      beam_photons;  // nullopt: "auto" (resolved per light by MfsIntegrator: auto_beam_photons)
   BeamSpread beam_spread = BeamSpread::straight;
   Splat photon_splat = Splat::trilinear;
   bool light_blur = true;
@@ -154,8 +155,14 @@ class MfsIntegrator final : public Integrator {
   std::vector<TransmittanceGrid> full_maps_, reduced_maps_;  // per light
   std::unique_ptr<ScatterGrid> grid_;                        // wide scatters 2 .. K (null for K = 1)
   std::unique_ptr<BeamGrid> beam_;                           // the peak-only beams' correction (or null)
+  std::vector<int> beam_counts_;                             // per light: the beam grid's photons
   double max_step_ = 0.0;        // the longest march step over analytic pieces (the grids' node spacing)
   bool shared_stencil_ = false;  // both photon grids, on one node layout: one stencil per march point
+  // The beam grid is built: the forward light path and photons for some light.
+  bool beam_on() const {
+    return s_.forward_light_path() &&
+           std::any_of(beam_counts_.begin(), beam_counts_.end(), [](int n) { return n > 0; });
+  }
 
   // The parts of `Li` (mfs.cpp); the physics is in mfs_estimators.h.
   struct MediumRadiance {

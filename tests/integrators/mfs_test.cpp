@@ -615,8 +615,10 @@ TEST(Mfs, BeamGridSkipsIdleCellsWithoutChangingTheMedia) {
     TransmittanceGrid::build_pair(ctx.media, ctx.majorants, light, 32, 0.25, f, &full.emplace_back(),
                                   &reduced.emplace_back());
   const Vec3 cam(0.0, -6.0, 0.0);
-  const BeamGrid skip(ctx, splits, f, full, reduced, 4096, 40, 7, true, &cam, nullptr, true);
-  const BeamGrid all(ctx, splits, f, full, reduced, 4096, 40, 7, true, &cam, nullptr, false);
+  const BeamGrid skip(ctx, splits, f, full, reduced, std::vector<int>(ctx.lights.size(), 4096), 40, 7, true,
+                      &cam, nullptr, true);
+  const BeamGrid all(ctx, splits, f, full, reduced, std::vector<int>(ctx.lights.size(), 4096), 40, 7, true,
+                     &cam, nullptr, false);
   std::printf("beam grid: idle share of the cells %.3f\n", skip.idle_share());
   EXPECT_GT(skip.idle_share(), 0.2);
   EXPECT_EQ(all.idle_share(), 0.0);
@@ -754,7 +756,8 @@ TEST(Mfs, BeamGridKeepsOneChannelForGreyMediaAndGreyLights) {
     for (const Light& light : ctx.lights)
       TransmittanceGrid::build_pair(ctx.media, ctx.majorants, light, 32, 0.25, f, &full.emplace_back(),
                                     &reduced.emplace_back());
-    return BeamGrid(ctx, splits, f, full, reduced, 4096, 24, 7, true, camera ? &cam : nullptr);
+    return BeamGrid(ctx, splits, f, full, reduced, std::vector<int>(ctx.lights.size(), 4096), 24, 7, true,
+                    camera ? &cam : nullptr);
   };
   EXPECT_EQ(grid(chromatic, false).channels(), 3);
   for (const bool camera : {false, true}) {

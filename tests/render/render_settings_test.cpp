@@ -81,6 +81,42 @@ TEST(RenderSettings, AutoPhotonsFollowTheMediumsCollisions) {
   EXPECT_EQ(render(settings_sphere_scene(given, 4, 3, 0.3)).settings["photons"], 5000);
 }
 
+// "auto" beam photons: 2^15 per light, and 2^15 sqrt(pixels / 128^2) for a light whose forward peak the
+// camera looks into (its light travels towards the camera within the peak's cut angle, about 37 degrees
+// for HG 0.8, plus the media's size on the image): a crop of a 256 x 256 image of a backlit sphere
+// traces 2^16, the 8 x 6 image and a side-lit sphere 2^15; with lights of both kinds the header says
+// "auto" (and renders the same image again); a count given is kept.
+TEST(RenderSettings, AutoBeamPhotonsFollowThePixelsWhereTheCameraLooksIntoTheForwardPeak) {
+  const auto scene = [](const std::string& lights, int size) {
+    return test::scene_from_json("{" + test::camera_json(size, size) + R"(,
+      "media": [{"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1}, "sigma_s": 2.0,
+                 "phase": {"type": "hg", "g": 0.8}}],
+      "lights": [)" + lights + R"(],
+      "integrator": {"type": "mfs", "spp": 1, "photons": 4096, "scatter_grid_resolution": 8}})");
+  };
+  const std::string back = R"({"type": "directional", "direction": [0.3, -1, 0.2], "irradiance": 1.0})";
+  const std::string side = R"({"type": "directional", "direction": [-1, 0.3, 0.2], "irradiance": 1.0})";
+  const std::string behind = R"({"type": "point", "position": [0.5, 6, 0], "intensity": 10.0})";
+  const std::string beside = R"({"type": "point", "position": [6, 0, 0.5], "intensity": 10.0})";
+  RenderOptions crop;
+  crop.region = Region{128, 128, 129, 129};
+  EXPECT_EQ(render(scene(back, 256), crop).settings["beam_photons"], 1 << 16);
+  EXPECT_EQ(render(scene(behind, 256), crop).settings["beam_photons"], 1 << 16);
+  EXPECT_EQ(render(scene(back, 8)).settings["beam_photons"], 1 << 15);
+  EXPECT_EQ(render(scene(side, 256), crop).settings["beam_photons"], 1 << 15);
+  EXPECT_EQ(render(scene(beside, 256), crop).settings["beam_photons"], 1 << 15);
+  const RenderResult both = render(scene(back + "," + side, 256), crop);
+  EXPECT_EQ(both.settings["beam_photons"], "auto");
+  const Scene again = parse_scene(nlohmann::json::parse(meta(both, "nimbus/scene")), "header", ".");
+  const RenderResult both2 = render(again, crop);
+  ASSERT_EQ(both2.image.rgb.size(), both.image.rgb.size());
+  EXPECT_EQ(std::memcmp(both2.image.rgb.data(), both.image.rgb.data(), both.image.rgb.size() * sizeof(float)),
+            0);
+  Scene given = scene(back, 256);
+  given.integrator.options["beam_photons"] = 1000;
+  EXPECT_EQ(render(given, crop).settings["beam_photons"], 1000);
+}
+
 // "auto" exact_light_transmittance: the closed-form chord for one constant-density sphere or box (the
 // same image as asking for it), the shadow maps otherwise (here: two spheres).
 TEST(RenderSettings, AutoExactLightTransmittanceIsTheChordForOneShape) {
