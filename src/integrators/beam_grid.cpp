@@ -85,10 +85,11 @@ size_t grid_cell(const NodeGrid& g, const Vec3& p) {
 // medium scatters (a lookup at a point reads the 8 nodes of its cell), so it is skipped, and R and the
 // mean cosine stay bit for bit what they were wherever there is a medium. Outside the media (in the
 // grid's padding, empty space inside the media's bounds, the shadow behind them) the tallies are
-// incomplete; `mfs` multiplies them by sigma_s there, which is 0.
-std::vector<uint8_t> idle_cells(const NodeGrid& g, const MajorantGrid& maj) {
+// incomplete; `mfs` multiplies them by sigma_s there, which is 0. Without skip: every cell 0 (none idle).
+std::vector<uint8_t> idle_cells(const NodeGrid& g, const MajorantGrid& maj, bool skip) {
   const std::array<int, 3> cells{g.nodes[0] - 1, g.nodes[1] - 1, g.nodes[2] - 1};
-  std::vector<uint8_t> idle(size_t(cells[0]) * cells[1] * cells[2], 1);
+  std::vector<uint8_t> idle(size_t(cells[0]) * cells[1] * cells[2], skip ? 1 : 0);
+  if (!skip) return idle;
   const std::array<int, 3> res = maj.resolution();
   const Bounds& mb = maj.bounds();
   if (mb.empty()) return idle;
@@ -113,6 +114,57 @@ std::vector<uint8_t> idle_cells(const NodeGrid& g, const MajorantGrid& maj) {
             for (int i = lo[0]; i <= hi[0]; ++i) idle[(size_t(k) * cells[1] + j) * cells[0] + i] = 0;
       }
   return idle;
+}
+
+// Per node: 1 where a medium has a density at the node itself.
+std::vector<uint8_t> nodes_inside(const NodeGrid& g, const SceneMedia& media) {
+  std::vector<uint8_t> in(g.size(), 0);
+  for (int z = 0; z < g.nodes[2]; ++z)
+    for (int y = 0; y < g.nodes[1]; ++y)
+      for (int x = 0; x < g.nodes[0]; ++x) in[g.index(x, y, z)] = media.inside(g.position(x, y, z));
+  return in;
+}
+
+// `passes` times, along each axis in turn, the filter [1 2 1] / 4 over the nodes inside the media: a
+// neighbour outside them (or beyond the grid) is left out and the weights renormalised, and the nodes
+// outside keep their tallies. Every column alike, so R = traced / straight at a node becomes the ratio of
+// the two tallies' local sums: the grid's noise, lines along single photons' deflected paths (streaks in
+// thin media, blotches along a backlit rim), is averaged over about one node spacing (two passes: the
+// binomial [1 4 6 4 1] / 16, a standard deviation of one spacing) without mixing in the R outside the
+// media (the light there scatters no more: beam_smoothing, docs/benchmarks.md).
+void smooth_one(FloatArray* v, const NodeGrid& g, const std::vector<uint8_t>& inside, int stride,
+                int passes) {
+  std::vector<float> before(v->size());
+  for (int pass = 0; pass < passes; ++pass)
+    for (int a = 0; a < 3; ++a) {
+      std::copy(v->begin(), v->end(), before.begin());
+      const size_t step = a == 0 ? 1 : a == 1 ? size_t(g.nodes[0]) : size_t(g.nodes[0]) * g.nodes[1];
+      for (int z = 0; z < g.nodes[2]; ++z)
+        for (int y = 0; y < g.nodes[1]; ++y)
+          for (int x = 0; x < g.nodes[0]; ++x) {
+            const size_t n = g.index(x, y, z);
+            if (!inside[n]) continue;
+            const int q = a == 0 ? x : a == 1 ? y : z;
+            const bool lo = q > 0 && inside[n - step], hi = q + 1 < g.nodes[a] && inside[n + step];
+            const float w = 1.0f / (2.0f + float(lo) + float(hi));
+            for (int k = 0; k < stride; ++k) {
+              const size_t i = n * size_t(stride) + size_t(k);
+              float sum = 2.0f * before[i];
+              if (lo) sum += before[i - step * size_t(stride)];
+              if (hi) sum += before[i + step * size_t(stride)];
+              (*v)[i] = sum * w;
+            }
+          }
+    }
+}
+
+// smooth_one for every light's tallies.
+void smooth_inside(std::vector<FloatArray>* values, const NodeGrid& g, const SceneMedia& media, int stride,
+                   int passes) {
+  if (passes <= 0) return;
+  const std::vector<uint8_t> inside = nodes_inside(g, media);
+  for (FloatArray& v : *values)
+    if (!v.empty()) smooth_one(&v, g, inside, stride, passes);
 }
 
 // True when every directional and point light's photons carry the same weight in all three channels (a
@@ -368,7 +420,7 @@ BeamGrid::BeamGrid(const SceneContext& ctx, const std::vector<const PhaseSplit*>
                    const std::vector<double>& peak_fraction, const std::vector<TransmittanceGrid>& full_maps,
                    const std::vector<TransmittanceGrid>& reduced_maps, const std::vector<int>& photons,
                    int resolution, uint64_t seed, bool spread, const Vec3* camera,
-                   const MajorantGrid* majorants, bool skip_idle)
+                   const MajorantGrid* majorants, bool skip_idle, int smoothing)
     : with_camera_(camera != nullptr), spread_(spread) {
   if (camera) camera_ = *camera;
   values_.resize(ctx.lights.size());
@@ -386,8 +438,7 @@ BeamGrid::BeamGrid(const SceneContext& ctx, const std::vector<const PhaseSplit*>
   const Vec3 centre = (media_bounds.lo + media_bounds.hi) * 0.5;
   // Photons cover the whole node grid (its padding included), so every node's estimate is complete.
   const double radius = 0.5 * (grid_.bounds.hi - grid_.bounds.lo).length() * (1.0 + 1e-9) + 1e-12;
-  std::vector<uint8_t> idle = idle_cells(grid_, ctx.majorants);
-  if (!skip_idle) std::fill(idle.begin(), idle.end(), uint8_t(0));
+  const std::vector<uint8_t> idle = idle_cells(grid_, ctx.majorants, skip_idle);
   idle_share_ = double(std::count(idle.begin(), idle.end(), uint8_t(1))) / double(idle.size());
   const double scale = majorant_share(ctx.media, [&](int i) { return peak_fraction[i]; });
   for (size_t l = 0; l < ctx.lights.size(); ++l) {
@@ -428,6 +479,7 @@ BeamGrid::BeamGrid(const SceneContext& ctx, const std::vector<const PhaseSplit*>
         1.0 / grid_.cell_volume(), [&](size_t j, Rng& rng, PhotonBatch& batch) { beam.trace(j, rng, batch); },
         &rejection_failures_);
   }
+  smooth_inside(&values_, grid_, ctx.media, stride_, smoothing);
 }
 
 bool BeamGrid::lookup(size_t light, const Vec3& p, const Rgb& T_light, const Rgb& T_wide, Rgb* factor,

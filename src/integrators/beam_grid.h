@@ -46,12 +46,14 @@ class BeamGrid {
   // only with `spread`); photons: per light (0: none); resolution as ScatterGridSettings. spread: tally the spread
   // (the straight model's takes medium 0's chi_1).
   // skip_idle: no deposits in cells with no medium in them or next to them (the lookup is the same
-  // wherever there is a medium; for tests: false deposits everywhere).
+  // wherever there is a medium; for tests: false deposits everywhere). smoothing: passes of the filter
+  // [1 2 1] / 4 along each axis over the nodes inside the media, every column of the tallies alike (the
+  // nodes outside untouched; `mfs`'s beam_smoothing).
   BeamGrid(const SceneContext& ctx, const std::vector<const PhaseSplit*>& splits,
            const std::vector<double>& peak_fraction, const std::vector<TransmittanceGrid>& full_maps,
            const std::vector<TransmittanceGrid>& reduced_maps, const std::vector<int>& photons,
            int resolution, uint64_t seed, bool spread, const Vec3* camera = nullptr,
-           const MajorantGrid* majorants = nullptr, bool skip_idle = true);
+           const MajorantGrid* majorants = nullptr, bool skip_idle = true, int smoothing = 0);
   // R for light `light` at p (trilinear between nodes) and, if mean_cosine is not null, the peak-only
   // light's mean cosine to the straight direction from the light, given the straight model's T_light and
   // T_wide at p (the spread's control variate; a grid without `spread`: the straight model's); false

@@ -52,7 +52,7 @@ MfsIntegrator::MfsIntegrator(const SceneContext& context, MfsSettings settings, 
     const bool toward = s_.peak_toward_camera && ctx_.media.count() == 1;
     beam_ = std::make_unique<BeamGrid>(
         ctx_, splits, f_, full_maps_, reduced_maps_, beam_counts_, *s_.scatter_grid_resolution, seed,
-        s_.beam_spread == BeamSpread::traced, toward ? &camera : nullptr, tracking);
+        s_.beam_spread == BeamSpread::traced, toward ? &camera : nullptr, tracking, true, s_.beam_smoothing);
   }
   // Wide scatters 2 .. K from the scatter grid (for K = 1 only the environment's light).
   if (s_.large_angle_scatters != 0 &&

@@ -40,6 +40,7 @@ MfsSettings mfs_settings_from_json(const nlohmann::json& options, const std::str
   s.forward_side = ForwardSide(o.choice("forward_side", kForwardSideNames, int(s.forward_side)));
   if (int64_t n = 0; o.keyword_or_integer("beam_photons", "auto", 0, 1 << 24, &n)) s.beam_photons = int(n);
   s.beam_spread = BeamSpread(o.choice("beam_spread", kBeamSpreadNames, int(s.beam_spread)));
+  s.beam_smoothing = int(o.integer("beam_smoothing", 0, 8, s.beam_smoothing));
   s.photon_splat = Splat(o.choice("photon_splat", kSplatNames, int(s.photon_splat)));
   s.light_blur = o.boolean("light_blur", s.light_blur);
   s.path_lengthening = o.boolean("path_lengthening", s.path_lengthening);
@@ -74,6 +75,7 @@ nlohmann::json to_json(const MfsSettings& s) {
                       {"scatter_grid_bands", s.scatter_grid_bands},
                       {"forward_side", kForwardSideNames[int(s.forward_side)]},
                       {"beam_spread", kBeamSpreadNames[int(s.beam_spread)]},
+                      {"beam_smoothing", s.beam_smoothing},
                       {"photon_splat", kSplatNames[int(s.photon_splat)]},
                       {"light_blur", s.light_blur},
                       {"path_lengthening", s.path_lengthening},

@@ -70,6 +70,7 @@ TEST(Registry, SettingsRoundTripThroughJson) {
                                               {"scatter_grid_bands", 2},
                                               {"forward_side", "camera"},
                                               {"beam_photons", 0},
+                                              {"beam_smoothing", 0},
                                               {"photon_splat", "stratified"},
                                               {"light_blur", false},
                                               {"path_lengthening", true},
@@ -83,6 +84,7 @@ TEST(Registry, SettingsRoundTripThroughJson) {
   expect_round_trip(&mfs_settings_from_json, {{"peak_fraction", "auto"},
                                               {"large_angle_scatters", "all"},
                                               {"scatter_grid_resolution", "auto"},
+                                              {"beam_photons", "auto"},
                                               {"exact_light_transmittance", "auto"}});
 }
 
@@ -97,7 +99,9 @@ TEST(Registry, DefaultsAreWrittenOut) {
   EXPECT_EQ(mfs["camera_shift"], false);
   EXPECT_EQ(mfs["exact_light_transmittance"], "auto");
   EXPECT_EQ(mfs["beam_spread"], "straight");
-  EXPECT_EQ(mfs.size(), 25u);  // every option of the table in mfs.h
+  EXPECT_EQ(mfs["beam_photons"], "auto");
+  EXPECT_EQ(mfs["beam_smoothing"], 2);
+  EXPECT_EQ(mfs.size(), 26u);  // every option of the table in mfs.h
 }
 
 TEST(Registry, UnknownFieldsAndNamesAreErrors) {
