@@ -16,7 +16,7 @@ render_suite.png (reference | mfs | octave | single | mfs error) and render_erro
     nice validation/mfs_validation.py [--only NAME] [--scale 1.0]
 Needs build/bin/nimbus, /usr/bin/python3 with numpy + matplotlib. ~1 h on 2 cores (references).
 """
-import argparse, json, math, os, resource, subprocess, time
+import argparse, json, math, os, resource, subprocess, sys, time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 NIMBUS = os.path.join(ROOT, "build", "bin", "nimbus")
