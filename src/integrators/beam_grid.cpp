@@ -327,9 +327,12 @@ Rgb BeamPhotons::deposit(float* tally, const Vec3& x, const Vec3& w, double t_en
 Rgb BeamPhotons::deposit_first(float* tally, const Vec3& x, const Vec3& w, double t_end, Rgb weight,
                                int c) const {
   double t0, t1;
-  if (!grid.bounds.intersect(x, w, 0.0, std::numeric_limits<double>::infinity(), &t0, &t1) ||
-      !(t1 - t0 > 0.0))
-    return weight;
+  // The straight line ends at the first surface on it, as the straight model's light does (`mfs` tests a
+  // surface's shadow on its own): in a surface's shadow both columns are empty, not R = 0.
+  SurfaceHit hit;
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  const double t_max = !ctx.surfaces.empty() && ctx.surfaces.intersect(x, w, kInf, &hit) ? hit.t : kInf;
+  if (!grid.bounds.intersect(x, w, 0.0, t_max, &t0, &t1) || !(t1 - t0 > 0.0)) return weight;
   const double len = t1 - t0;
   const int n = std::max(1, int(std::ceil(len / (kDepositStep * grid.min_spacing()))));
   const double dl = len / n;

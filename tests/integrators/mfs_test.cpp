@@ -652,6 +652,48 @@ TEST(Mfs, BeamGridSkipsIdleCellsWithoutChangingTheMedia) {
   EXPECT_GT(gap_differs, gap / 2);
 }
 
+// The beam grid's straight line ends at the first surface on it, as the straight model's light does
+// (`mfs` tests a surface's shadow itself): under an opaque roof over half of a thin fog both columns are
+// empty, so R is 1 there. A straight deposit that went on through the roof left R = traced / straight of
+// 0 in the shadow (the least R there was 0.000), which the lookups' trilinear weights and the smoothing
+// carried into the lit fog beside it. Far from the shadow R is about 1 on average (thin fog: little is
+// deflected away); just beside it R is below 1 in truth (light deflected into the shadow is lost there).
+TEST(Mfs, BeamGridStraightLineEndsAtSurfaces) {
+  const Scene scene = test::scene_from_json("{" + test::camera_json(8, 8) + R"(,
+    "media": [{"shape": {"type": "box", "min": [-2, -2, -1], "max": [2, 2, 1]}, "sigma_s": 0.5, "sigma_a": 0.01,
+               "phase": {"type": "hg", "g": 0.85}}],
+    "surfaces": [{"shape": {"type": "rectangle", "center": [-1, 0, 1.5], "normal": [0, 0, 1], "up": [0, 1, 0],
+                            "size": [2, 4]}, "material": {"type": "diffuse", "albedo": 0.5}}],
+    "lights": [{"type": "directional", "direction": [0, 0, -1], "irradiance": 1.0}]})");
+  const SceneContext ctx(scene);
+  MfsSettings ms = mfs_settings_from_json(nlohmann::json::object(), "test");
+  ms.large_angle_scatters = 0;
+  ms.beam_photons = 0;
+  const MfsIntegrator mfs(ctx, ms);
+  const std::vector<const PhaseSplit*> splits{&mfs.split(0)};
+  const std::vector<double> f{mfs.split(0).f()};
+  std::vector<TransmittanceGrid> full, reduced;
+  TransmittanceGrid::build_pair(ctx.media, ctx.majorants, ctx.lights[0], 32, 0.25, f, &full.emplace_back(),
+                                &reduced.emplace_back());
+  const BeamGrid g(ctx, splits, f, full, reduced, {1 << 14}, 32, 3, false);
+  double shade_min = 2.0, lit_mean = 0.0;
+  for (int i = 0; i < 40; ++i) {
+    const double y = -1.5 + 3.0 * i / 39.0;
+    for (const double z : {-0.5, 0.0, 0.5}) {
+      Rgb R;
+      const Vec3 shade(-1.2, y, z), lit(1.2, y, z);
+      ASSERT_TRUE(g.lookup(0, shade, full[0].lookup(shade), reduced[0].lookup(shade), &R, nullptr));
+      shade_min = std::min(shade_min, R[0]);
+      ASSERT_TRUE(g.lookup(0, lit, full[0].lookup(lit), reduced[0].lookup(lit), &R, nullptr));
+      lit_mean += R[0] / 120.0;
+    }
+  }
+  std::printf("beam grid under a roof: least R in the shadow %.3f, mean R in the light %.3f\n", shade_min,
+              lit_mean);
+  EXPECT_GT(shade_min, 0.9);
+  EXPECT_NEAR(lit_mean, 1.0, 0.05);
+}
+
 // beam_smoothing: the [1 2 1] / 4 filter, twice along each axis over the nodes inside the media, averages
 // the beam grid's noise (lines along single photons' deflected paths) and leaves the nodes outside as they
 // are. A thin backlit sphere (optical radius 2, HG 0.85, the photons mostly deflected once or twice):
