@@ -95,12 +95,10 @@ namespace {
 // on the disc of radius r, else the density h / (2 pi (h^2 + rho^2)^(3/2)) over the plane), `back` behind
 // it along w. *area: 1 / the mixture's density there. h: the distance from c along w to the first surface
 // (at least r): a ground h below sends the media light from a distance rho along it as h / (h^2 +
-// rho^2)^(3/2) (the solid angle of the media times the cosine at the ground), the density itself.
-Vec3 plane_point(const SceneContext& ctx, const Vec3& c, const Vec3& w, double r, double back, double u0,
-                 double u1, double u2, double* area) {
-  SurfaceHit hit;
-  const double h =
-      ctx.surfaces.intersect(c, w, std::numeric_limits<double>::infinity(), &hit) ? std::max(r, hit.t) : r;
+// rho^2)^(3/2) (the solid angle of the media times the cosine at the ground), the density itself
+// (plane_height).
+Vec3 plane_point(const Vec3& c, const Vec3& w, double r, double h, double back, double u0, double u1,
+                 double u2, double* area) {
   const double v = 1.0 - u1;  // in (0, 1]
   const double rho = u0 < kAimedShare ? r * std::sqrt(u1) : h * std::sqrt(std::max(0.0, 1.0 / (v * v) - 1.0));
   const double phi = 2.0 * kPi * u2, s = std::sqrt(h * h + rho * rho);
@@ -134,6 +132,21 @@ Photon point_with_surfaces(const Vec3& x, const Vec3& to_c, double cos_aim, doub
 
 }  // namespace
 
+double plane_height(const SceneContext& ctx, const Vec3& c, const Vec3& w, double r) {
+  SurfaceHit hit;
+  return ctx.surfaces.intersect(c, w, std::numeric_limits<double>::infinity(), &hit) ? std::max(r, hit.t) : r;
+}
+
+SurfaceEmission surface_emission(const SceneContext& ctx, const Vec3& c, double r) {
+  SurfaceEmission e;
+  e.back = photon_start_distance(ctx, c, r);
+  for (const Light& light : ctx.lights) {
+    const auto* d = std::get_if<DirectionalLight>(&light);
+    e.plane_h.push_back(d ? plane_height(ctx, c, normalize(d->direction), r) : 0.0);
+  }
+  return e;
+}
+
 double photon_start_distance(const SceneContext& ctx, const Vec3& c, double r) {
   const Bounds& sb = ctx.surfaces.bounds();
   double reach = 0.0;
@@ -145,8 +158,8 @@ double photon_start_distance(const SceneContext& ctx, const Vec3& c, double r) {
   return 2.0 * r + reach;
 }
 
-Photon emit_with_surfaces(const SceneContext& ctx, size_t source, const Vec3& c, double r, double back,
-                          double n, Rng& rng) {
+Photon emit_with_surfaces(const SceneContext& ctx, size_t source, const Vec3& c, double r,
+                          const SurfaceEmission& se, double n, Rng& rng) {
   const double u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform(), u3 = rng.uniform(),
                u4 = rng.uniform();
   double area = 0.0;
@@ -155,7 +168,7 @@ Photon emit_with_surfaces(const SceneContext& ctx, size_t source, const Vec3& c,
     const Light& light = ctx.lights[source];
     if (const auto* d = std::get_if<DirectionalLight>(&light)) {
       p.w = normalize(d->direction);
-      p.x = plane_point(ctx, c, p.w, r, back, u0, u3, u4, &area);
+      p.x = plane_point(c, p.w, r, se.plane_h[source], se.back, u0, u3, u4, &area);
       p.power = d->irradiance * (kPi * r * r / n);  // emit's, over the weight area / (pi r^2)
       p.weight = area / (kPi * r * r);
       return p;
@@ -179,7 +192,7 @@ Photon emit_with_surfaces(const SceneContext& ctx, size_t source, const Vec3& c,
   } else {
     p.w = spherical_direction(1.0 - 2.0 * u1, 2.0 * kPi * u2, Vec3(0, 0, 1));
   }
-  p.x = plane_point(ctx, c, p.w, r, back, u0, u3, u4, &area);
+  p.x = plane_point(c, p.w, r, plane_height(ctx, c, p.w, r), se.back, u0, u3, u4, &area);
   p.power = pdf > 0.0 ? radiance * (kPi * r * r / (pdf * n)) : Rgb(0.0);
   p.weight = area / (kPi * r * r);
   return p;

@@ -63,11 +63,21 @@ Photon emit(const SceneContext& ctx, size_t source, const Vec3& c, double r, dou
 // lights (whose photons already leave in every direction) and spots whose cone is the narrower are emit's.
 // Consumes 5 uniform numbers (then emit's 4 where it falls back to emit).
 inline constexpr double kAimedShare = 0.75;
-Photon emit_with_surfaces(const SceneContext& ctx, size_t source, const Vec3& c, double r, double back,
-                          double n, Rng& rng);
+// What emit_with_surfaces needs of the scene once per grid, not per photon: how far behind the plane
+// through c its photons start (photon_start_distance), and per light the plane's h for a directional light
+// (the same for all its photons; 0 for the others).
+struct SurfaceEmission {
+  double back = 0.0;
+  std::vector<double> plane_h;
+};
+SurfaceEmission surface_emission(const SceneContext& ctx, const Vec3& c, double r);
+Photon emit_with_surfaces(const SceneContext& ctx, size_t source, const Vec3& c, double r,
+                          const SurfaceEmission& se, double n, Rng& rng);
 // How far behind the plane through c emit_with_surfaces' photons start: emit's 2 r past the farthest
-// corner of the surfaces' bounds (once per grid, not per photon).
+// corner of the surfaces' bounds.
 double photon_start_distance(const SceneContext& ctx, const Vec3& c, double r);
+// The far plane's h for photons along w: the distance from c along w to the first surface, at least r.
+double plane_height(const SceneContext& ctx, const Vec3& c, const Vec3& w, double r);
 // True when every medium's sigma_s and sigma_a are equal in all channels (one photon pass carries RGB).
 bool grey_media(const SceneContext& ctx);
 

@@ -309,12 +309,12 @@ struct ScatterPhotons {
   const EmissionSampler* emission;  // null when no medium emits
   Vec3 centre;                      // of the media's bounding sphere, which the photons are aimed at
   double radius;
-  double back = 0.0;                // with surfaces: emit_with_surfaces' start (photon_start_distance)
+  SurfaceEmission surface;          // with surfaces: emit_with_surfaces' start and far planes
   int K;                            // flights after wide scatter 1 .. K - 1 are kept
   double majorant_scale;            // the share of the majorant that bounds the extinction the photons see
   std::vector<SourceBlock> blocks;  // per source, as trace numbers them
 
-  void split(int photons);  // first = photon_split(..., photons, ...), and back
+  void split(int photons);  // first = photon_split(..., photons, ...), and surface
   void trace(size_t j, Rng& rng, PhotonBatch& batch) const;
   bool reflect(const SurfaceHit& hit, Vec3* w, int c, double* weight, int* order, Rng& rng) const;
   bool bounce(const SurfaceHit& hit, Vec3* w, double* factor, Rng& rng) const;
@@ -349,7 +349,7 @@ void ScatterPhotons::trace(size_t j, Rng& rng, PhotonBatch& batch) const {
   const int c = pass;  // the channel whose coefficients drive this photon
   const Photon ph = from_media             ? emit_from_media(*emission, ctx.media, n, rng)
                     : ctx.surfaces.empty() ? emit(ctx, source, centre, radius, n, rng)
-                                           : emit_with_surfaces(ctx, source, centre, radius, back, n, rng);
+                                           : emit_with_surfaces(ctx, source, centre, radius, surface, n, rng);
   const SourceBlock& sb = blocks[src];
   const TallyBlock block{.mono = sb.offset >= 0 ? batch.tally.data() + sb.offset : nullptr,
                          .colour = sb.colour,
@@ -628,7 +628,7 @@ bool wants_pilot(const ScatterGridSettings& s) {
 
 void ScatterPhotons::split(int photons) {
   first = photon_split(ctx, emission, s, photons, lights, sources, centre, radius);
-  back = ctx.surfaces.empty() ? 0.0 : photon_start_distance(ctx, centre, radius);
+  if (!ctx.surfaces.empty()) surface = surface_emission(ctx, centre, radius);
 }
 
 // Real collisions per photon of kPilotPhotons photons of a pass (photons.first is left split for them),
