@@ -12,6 +12,40 @@
 #include "integrators/photon_tracer.h"
 
 namespace nimbus {
+
+// `passes` times, along each axis in turn, the filter [1 2 1] / 4 over the nodes inside the media: a
+// neighbour outside them (or beyond the grid) is left out and the weights renormalised, and the nodes
+// outside keep their tallies. Every column alike, so R = traced / straight at a node becomes the ratio of
+// the two tallies' local sums: the grid's noise, lines along single photons' deflected paths (streaks in
+// thin media, blotches along a backlit rim), is averaged over about one node spacing (two passes: the
+// binomial [1 4 6 4 1] / 16, a standard deviation of one spacing) without mixing in the R outside the
+// media (the light there scatters no more: beam_smoothing, docs/benchmarks.md).
+void smooth_nodes_inside(FloatArray* v, const NodeGrid& g, const std::vector<uint8_t>& inside, int stride,
+                         int passes) {
+  std::vector<float> before(v->size());
+  for (int pass = 0; pass < passes; ++pass)
+    for (int a = 0; a < 3; ++a) {
+      std::copy(v->begin(), v->end(), before.begin());
+      const size_t step = a == 0 ? 1 : a == 1 ? size_t(g.nodes[0]) : size_t(g.nodes[0]) * g.nodes[1];
+      for (int z = 0; z < g.nodes[2]; ++z)
+        for (int y = 0; y < g.nodes[1]; ++y)
+          for (int x = 0; x < g.nodes[0]; ++x) {
+            const size_t n = g.index(x, y, z);
+            if (!inside[n]) continue;
+            const int q = a == 0 ? x : a == 1 ? y : z;
+            const bool lo = q > 0 && inside[n - step], hi = q + 1 < g.nodes[a] && inside[n + step];
+            const float w = 1.0f / (2.0f + float(lo) + float(hi));
+            for (int k = 0; k < stride; ++k) {
+              const size_t i = n * size_t(stride) + size_t(k);
+              float sum = 2.0f * before[i];
+              if (lo) sum += before[i - step * size_t(stride)];
+              if (hi) sum += before[i + step * size_t(stride)];
+              (*v)[i] = sum * w;
+            }
+          }
+    }
+}
+
 namespace {
 
 // Per node, blocks of `channels` floats (3: rgb; 1: grey media under lights of grey strength, whose three
@@ -125,46 +159,33 @@ std::vector<uint8_t> nodes_inside(const NodeGrid& g, const SceneMedia& media) {
   return in;
 }
 
-// `passes` times, along each axis in turn, the filter [1 2 1] / 4 over the nodes inside the media: a
-// neighbour outside them (or beyond the grid) is left out and the weights renormalised, and the nodes
-// outside keep their tallies. Every column alike, so R = traced / straight at a node becomes the ratio of
-// the two tallies' local sums: the grid's noise, lines along single photons' deflected paths (streaks in
-// thin media, blotches along a backlit rim), is averaged over about one node spacing (two passes: the
-// binomial [1 4 6 4 1] / 16, a standard deviation of one spacing) without mixing in the R outside the
-// media (the light there scatters no more: beam_smoothing, docs/benchmarks.md).
-void smooth_one(FloatArray* v, const NodeGrid& g, const std::vector<uint8_t>& inside, int stride,
-                int passes) {
-  std::vector<float> before(v->size());
-  for (int pass = 0; pass < passes; ++pass)
-    for (int a = 0; a < 3; ++a) {
-      std::copy(v->begin(), v->end(), before.begin());
-      const size_t step = a == 0 ? 1 : a == 1 ? size_t(g.nodes[0]) : size_t(g.nodes[0]) * g.nodes[1];
-      for (int z = 0; z < g.nodes[2]; ++z)
-        for (int y = 0; y < g.nodes[1]; ++y)
-          for (int x = 0; x < g.nodes[0]; ++x) {
-            const size_t n = g.index(x, y, z);
-            if (!inside[n]) continue;
-            const int q = a == 0 ? x : a == 1 ? y : z;
-            const bool lo = q > 0 && inside[n - step], hi = q + 1 < g.nodes[a] && inside[n + step];
-            const float w = 1.0f / (2.0f + float(lo) + float(hi));
-            for (int k = 0; k < stride; ++k) {
-              const size_t i = n * size_t(stride) + size_t(k);
-              float sum = 2.0f * before[i];
-              if (lo) sum += before[i - step * size_t(stride)];
-              if (hi) sum += before[i + step * size_t(stride)];
-              (*v)[i] = sum * w;
-            }
-          }
+// Where a node's straight tally is 0 in a channel (a surface's shadow: the straight line ended at the
+// surface), its traced columns are dropped too: light deflected into the shadow (unused there: `mfs` tests
+// the shadow itself) would otherwise raise R in the lit medium beside it through the lookups' trilinear
+// weights and the smoothing. Without surfaces every node the photons reach has a straight tally.
+void drop_unmatched(FloatArray* v, int channels, Blocks b) {
+  const size_t stride = size_t(channels) * size_t(b.count());
+  for (size_t n = 0; n + stride <= v->size(); n += stride) {
+    float* node = v->data() + n;
+    for (int c = 0; c < channels; ++c) {
+      if (node[channels + c] != 0.0f) continue;
+      node[c] = 0.0f;
+      if (b.spread) node[2 * channels + c] = 0.0f;
+      if (b.pk) node[b.pk_block() * channels + c] = 0.0f;
     }
+  }
 }
 
-// smooth_one for every light's tallies.
-void smooth_inside(std::vector<FloatArray>* values, const NodeGrid& g, const SceneMedia& media, int stride,
-                   int passes) {
-  if (passes <= 0) return;
+// Every light's tallies: drop_unmatched, then `passes` of smooth_nodes_inside over the nodes inside the media.
+void finish_tallies(std::vector<FloatArray>* values, const NodeGrid& g, const SceneMedia& media, int channels,
+                    Blocks b, int passes) {
+  bool any = false;
+  for (FloatArray& v : *values)
+    if (!v.empty()) drop_unmatched(&v, channels, b), any = true;
+  if (passes <= 0 || !any) return;
   const std::vector<uint8_t> inside = nodes_inside(g, media);
   for (FloatArray& v : *values)
-    if (!v.empty()) smooth_one(&v, g, inside, stride, passes);
+    if (!v.empty()) smooth_nodes_inside(&v, g, inside, channels * b.count(), passes);
 }
 
 // True when every directional and point light's photons carry the same weight in all three channels (a
@@ -482,7 +503,7 @@ BeamGrid::BeamGrid(const SceneContext& ctx, const std::vector<const PhaseSplit*>
         1.0 / grid_.cell_volume(), [&](size_t j, Rng& rng, PhotonBatch& batch) { beam.trace(j, rng, batch); },
         &rejection_failures_);
   }
-  smooth_inside(&values_, grid_, ctx.media, stride_, smoothing);
+  finish_tallies(&values_, grid_, ctx.media, channels_, blocks, smoothing);
 }
 
 bool BeamGrid::lookup(size_t light, const Vec3& p, const Rgb& T_light, const Rgb& T_wide, Rgb* factor,

@@ -90,4 +90,10 @@ class BeamGrid {
   Vec3 camera_{0.0};  // the point P_peak is tallied towards
 };
 
+// `passes` times, along each axis in turn, the filter [1 2 1] / 4 over the nodes of g inside the media
+// (inside[n] != 0), `stride` floats per node, every float alike: a neighbour outside (or beyond the grid) is
+// left out and the weights renormalised; the nodes outside keep their values. (BeamGrid's smoothing.)
+void smooth_nodes_inside(FloatArray* v, const NodeGrid& g, const std::vector<uint8_t>& inside, int stride,
+                         int passes);
+
 }  // namespace nimbus

@@ -119,7 +119,10 @@ std::optional<MajorantGrid> photon_majorant_grid(const SceneContext& ctx, const 
     }
   }
   double photons = double(s.photons.value_or(0));
-  for (const int n : beam_counts) photons += double(n);
+  for (size_t l = 0; l < beam_counts.size() && l < ctx.lights.size(); ++l)  // the beam grid traces these only
+    if (std::holds_alternative<DirectionalLight>(ctx.lights[l]) ||
+        std::holds_alternative<PointLight>(ctx.lights[l]))
+      photons += double(beam_counts[l]);
   if (!(voxels > 0.0 && voxels <= 16.0 * photons)) return std::nullopt;
   const auto r = ctx.majorants.resolution();
   return std::optional<MajorantGrid>(std::in_place, ctx.media, std::max({r[0], r[1], r[2]}), false, true);
@@ -159,46 +162,49 @@ int auto_photons(const PinholeCamera& camera) {
   return int(std::min(std::round(n), double(1 << 26)));
 }
 
-// "auto" beam-grid photons, per light: 2^15, and 2^15 sqrt(pixels / 128^2) (at most 8 times 2^15) for a
-// directional or point light whose forward peak the camera looks into. The beam grid's noise reaches the
-// image through the peak-only light (eq. D7, second term), which leaves a peak scatter within the cut
-// angle theta_c of the light's direction of travel: it is most of a backlit medium's rim and next to
-// nothing where the camera sees the light from the side. Measured at 512 x 512 (docs/benchmarks.md, "Beam
-// photons by image size", 2 seeds): 4 x 2^15 gives 0.68x error^2 x CPU on the backlit r = 10 sphere and
-// 0.77x on the r = 20 one, but 1.06x on the side-lit r = 10 sphere and 1.07x on the double HG one (their
-// error did not fall). "Looks into": the angle between the light's direction of travel (from a point
-// light: towards the media's centre) and the direction from the media's centre to the camera is at most
-// theta_c plus the angle the media's bounds subtend at the camera (at most half the image's diagonal) plus,
-// for a point light, the angle they subtend at the light. The full image's pixels, as auto_photons.
 namespace {
 constexpr int kAutoBeamPhotons = 1 << 15;
+// Whether the camera looks into a directional or point light's forward peak: the angle between the light's
+// direction of travel (from a point light: towards the media's centre) and the direction from the media's
+// centre to the camera is at most theta_c plus how far the directions from the media's visible points to the
+// camera turn from that one: the angle the media's bounds subtend at the camera, at most the angle between the
+// camera's axis and the media's centre plus half the image's diagonal; for a point light, plus the angle the
+// bounds subtend at the light. A camera within the bounds' sphere may look anywhere: true.
 bool camera_in_forward_peak(const SceneContext& ctx, const Light& light, double cut_angle) {
   const Bounds& b = ctx.media.bounds();
   if (b.empty() || !(cut_angle > 0.0)) return false;
+  const auto* dir = std::get_if<DirectionalLight>(&light);
+  const auto* point = std::get_if<PointLight>(&light);
+  if (!dir && !point) return false;  // the beam grid traces directional and point lights only
   const Vec3 centre = (b.lo + b.hi) * 0.5;
   const double radius = 0.5 * (b.hi - b.lo).length();
-  // The angle a sphere of the bounds' radius subtends (its half-angle) from a point at distance d.
-  const auto subtends = [&](double d) { return d > radius ? std::asin(radius / d) : kPi; };
+  const auto angle = [](const Vec3& u, const Vec3& v) { return std::acos(std::clamp(dot(u, v), -1.0, 1.0)); };
   const PinholeCamera& cam = ctx.camera;
   const Vec3 to_camera = cam.origin() - centre;
-  const double half_diagonal = std::acos(std::clamp(
-      dot(cam.direction(0.0, 0.0), cam.direction(0.5 * cam.width(), 0.5 * cam.height())), -1.0, 1.0));
-  double reach = cut_angle + std::min(subtends(to_camera.length()), half_diagonal);
-  Vec3 travel;
-  if (const auto* d = std::get_if<DirectionalLight>(&light)) {
-    travel = normalize(d->direction);
-  } else if (const auto* p = std::get_if<PointLight>(&light)) {
-    travel = centre - p->position;
-    reach += subtends(travel.length());
-    travel = normalize(travel);
-  } else {
-    return false;  // the beam grid traces directional and point lights only
+  const double distance = to_camera.length();
+  if (!(distance > radius)) return true;
+  const Vec3 v = to_camera / distance, axis = cam.direction(0.5 * cam.width(), 0.5 * cam.height());
+  const double half_diagonal = angle(cam.direction(0.0, 0.0), axis);
+  double reach = cut_angle + std::min(std::asin(radius / distance), angle(-v, axis) + half_diagonal);
+  Vec3 travel = dir ? normalize(dir->direction) : centre - point->position;
+  if (point) {
+    const double d = travel.length();
+    if (!(d > radius)) return true;  // a light within the media sends its light every way
+    reach += std::asin(radius / d);
+    travel = travel / d;
   }
-  if (!(to_camera.length() > 0.0) || !(travel.length() > 0.0)) return true;
-  return std::acos(std::clamp(dot(travel, normalize(to_camera)), -1.0, 1.0)) <= reach;
+  return angle(travel, v) <= reach;
 }
 }  // namespace
 
+// "auto" beam-grid photons, per light: 2^15, and 2^15 sqrt(pixels / 128^2) (at most 8 times 2^15) for a
+// directional or point light whose forward peak the camera looks into (camera_in_forward_peak). The beam
+// grid's noise reaches the image through the peak-only light (eq. D7, second term), which leaves a peak
+// scatter within the cut angle theta_c of the light's direction of travel: it is most of a backlit medium's
+// rim and next to nothing where the camera sees the light from the side. Measured at 512 x 512
+// (docs/benchmarks.md, "Beam photons by image size", 2 seeds): 4 x 2^15 gives 0.68x error^2 x CPU on the
+// backlit r = 10 sphere and 0.77x on the r = 20 one, but 1.06x on the side-lit r = 10 sphere and 1.07x on the
+// double HG one (their error did not fall). The full image's pixels, as auto_photons.
 std::vector<int> auto_beam_photons(const SceneContext& ctx, double cut_angle) {
   const double pixels = double(ctx.camera.width()) * double(ctx.camera.height());
   const double scale = std::min(8.0, std::sqrt(std::max(1.0, pixels / (128.0 * 128.0))));

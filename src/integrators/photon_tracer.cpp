@@ -168,6 +168,7 @@ Photon emit_with_surfaces(const SceneContext& ctx, size_t source, const Vec3& c,
     const Light& light = ctx.lights[source];
     if (const auto* d = std::get_if<DirectionalLight>(&light)) {
       p.w = normalize(d->direction);
+      NIMBUS_DCHECK(source < se.plane_h.size());  // se: surface_emission(ctx, c, r)
       p.x = plane_point(c, p.w, r, se.plane_h[source], se.back, u0, u3, u4, &area);
       p.power = d->irradiance * (kPi * r * r / n);  // emit's, over the weight area / (pi r^2)
       p.weight = area / (kPi * r * r);

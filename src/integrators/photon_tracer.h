@@ -65,7 +65,7 @@ Photon emit(const SceneContext& ctx, size_t source, const Vec3& c, double r, dou
 inline constexpr double kAimedShare = 0.75;
 // What emit_with_surfaces needs of the scene once per grid, not per photon: how far behind the plane
 // through c its photons start (photon_start_distance), and per light the plane's h for a directional light
-// (the same for all its photons; 0 for the others).
+// (the same for all its photons; 0 for the others). emit_with_surfaces takes the one made for its c and r.
 struct SurfaceEmission {
   double back = 0.0;
   std::vector<double> plane_h;

@@ -84,8 +84,9 @@ TEST(RenderSettings, AutoPhotonsFollowTheMediumsCollisions) {
 // "auto" beam photons: 2^15 per light, and 2^15 sqrt(pixels / 128^2) for a light whose forward peak the
 // camera looks into (its light travels towards the camera within the peak's cut angle, about 37 degrees
 // for HG 0.8, plus the media's size on the image): a crop of a 256 x 256 image of a backlit sphere
-// traces 2^16, the 8 x 6 image and a side-lit sphere 2^15; with lights of both kinds the header says
-// "auto" (and renders the same image again); a count given is kept.
+// traces 2^16 (2048 x 2048: 2^18, the most), the 8 x 6 image, a side-lit sphere and a spot light (which the
+// beam grid does not trace) 2^15, a camera inside the media 2^16 for any light; with lights of both kinds the
+// header says "auto" (and renders the same image again); a count given is kept.
 TEST(RenderSettings, AutoBeamPhotonsFollowThePixelsWhereTheCameraLooksIntoTheForwardPeak) {
   const auto scene = [](const std::string& lights, int size) {
     return test::scene_from_json("{" + test::camera_json(size, size) + R"(,
@@ -112,6 +113,17 @@ TEST(RenderSettings, AutoBeamPhotonsFollowThePixelsWhereTheCameraLooksIntoTheFor
   ASSERT_EQ(both2.image.rgb.size(), both.image.rgb.size());
   EXPECT_EQ(std::memcmp(both2.image.rgb.data(), both.image.rgb.data(), both.image.rgb.size() * sizeof(float)),
             0);
+  crop.region = Region{1000, 1000, 1001, 1001};
+  EXPECT_EQ(render(scene(back, 2048), crop).settings["beam_photons"], 1 << 18);  // at most 8 x 2^15
+  crop.region = Region{128, 128, 129, 129};
+  const std::string spot =
+      R"({"type": "spot", "position": [0.5, 6, 0], "direction": [0, -1, 0], "intensity": 10.0, "cone_angle_deg": 60})";
+  EXPECT_EQ(render(scene(spot, 256), crop).settings["beam_photons"],
+            1 << 15);  // the beam grid traces no spot
+  // A camera inside the media's bounds may look anywhere: every light is counted as seen along its peak.
+  Scene inside = scene(side, 256);
+  inside.media[0].shape = SphereShape{Vec3(0.0), 8.0};
+  EXPECT_EQ(render(inside, crop).settings["beam_photons"], 1 << 16);
   Scene given = scene(back, 256);
   given.integrator.options["beam_photons"] = 1000;
   EXPECT_EQ(render(given, crop).settings["beam_photons"], 1000);
