@@ -591,6 +591,30 @@ TEST(Mfs, BeamGridTalliesThePeakTowardsTheCamera) {
   std::printf("peak towards the camera, thin sphere: worst |error| / (P_peak + 0.1) %.4f\n", worst);
 }
 
+// What a BeamGrid is built from, for a scene: the phase splits of `mfs` (built without its own beam grid,
+// K = 0) for every medium, and every light's pair of maps (32 nodes, 0.25 optical-depth steps).
+struct BeamInputs {
+  static MfsSettings settings() {
+    MfsSettings ms = mfs_settings_from_json(nlohmann::json::object(), "test");
+    ms.large_angle_scatters = 0;
+    ms.beam_photons = 0;
+    return ms;
+  }
+  explicit BeamInputs(const SceneContext& ctx) : mfs(ctx, settings()) {
+    for (int i = 0; i < ctx.media.count(); ++i) {
+      splits.push_back(&mfs.split(i));
+      f.push_back(mfs.split(i).f());
+    }
+    for (const Light& light : ctx.lights)
+      TransmittanceGrid::build_pair(ctx.media, ctx.majorants, light, 32, 0.25, f, &full.emplace_back(),
+                                    &reduced.emplace_back());
+  }
+  MfsIntegrator mfs;
+  std::vector<const PhaseSplit*> splits;
+  std::vector<double> f;
+  std::vector<TransmittanceGrid> full, reduced;
+};
+
 // The beam grid skips its deposits in cells with no medium in them or next to them (idle cells: the gap
 // between two spheres). Wherever there is a medium, R, the mean cosine and P_peak towards the camera must
 // be bit for bit those of the grid that deposits everywhere (a lookup reads only its cell's nodes); in the
@@ -604,16 +628,11 @@ TEST(Mfs, BeamGridSkipsIdleCellsWithoutChangingTheMedia) {
     "lights": [{"type": "directional", "direction": [1, -0.3, 0.2], "irradiance": 1.0},
                {"type": "point", "position": [-3, -1.5, 0.5], "intensity": 2.0}]})");
   const SceneContext ctx(scene);
-  MfsSettings ms = mfs_settings_from_json(nlohmann::json::object(), "test");
-  ms.large_angle_scatters = 0;
-  ms.beam_photons = 0;
-  const MfsIntegrator mfs(ctx, ms);
-  const std::vector<const PhaseSplit*> splits{&mfs.split(0), &mfs.split(1)};
-  const std::vector<double> f{mfs.split(0).f(), mfs.split(1).f()};
-  std::vector<TransmittanceGrid> full, reduced;
-  for (const Light& light : ctx.lights)
-    TransmittanceGrid::build_pair(ctx.media, ctx.majorants, light, 32, 0.25, f, &full.emplace_back(),
-                                  &reduced.emplace_back());
+  const BeamInputs inputs(ctx);
+  const auto& splits = inputs.splits;
+  const auto& f = inputs.f;
+  const auto& full = inputs.full;
+  const auto& reduced = inputs.reduced;
   const Vec3 cam(0.0, -6.0, 0.0);
   const BeamGrid skip(ctx, splits, f, full, reduced, std::vector<int>(ctx.lights.size(), 4096), 40, 7, true,
                       &cam, nullptr, true);
@@ -668,15 +687,11 @@ TEST(Mfs, BeamGridStraightLineEndsAtSurfaces) {
                             "size": [2, 4]}, "material": {"type": "diffuse", "albedo": 0.5}}],
     "lights": [{"type": "directional", "direction": [0, 0, -1], "irradiance": 1.0}]})");
   const SceneContext ctx(scene);
-  MfsSettings ms = mfs_settings_from_json(nlohmann::json::object(), "test");
-  ms.large_angle_scatters = 0;
-  ms.beam_photons = 0;
-  const MfsIntegrator mfs(ctx, ms);
-  const std::vector<const PhaseSplit*> splits{&mfs.split(0)};
-  const std::vector<double> f{mfs.split(0).f()};
-  std::vector<TransmittanceGrid> full, reduced;
-  TransmittanceGrid::build_pair(ctx.media, ctx.majorants, ctx.lights[0], 32, 0.25, f, &full.emplace_back(),
-                                &reduced.emplace_back());
+  const BeamInputs inputs(ctx);
+  const auto& splits = inputs.splits;
+  const auto& f = inputs.f;
+  const auto& full = inputs.full;
+  const auto& reduced = inputs.reduced;
   const BeamGrid g(ctx, splits, f, full, reduced, {1 << 14}, 32, 3, false);
   const BeamGrid smoothed(ctx, splits, f, full, reduced, {1 << 14}, 32, 3, false, nullptr, nullptr, true, 2);
   double beside = 0.0;  // the smoothed grid's mean R one to two node spacings (0.13) beside the shadow
@@ -764,15 +779,11 @@ TEST(Mfs, BeamGridSmoothingAveragesTheNoiseInsideTheMediaOnly) {
                "phase": {"type": "hg", "g": 0.85}}],
     "lights": [{"type": "directional", "direction": [-0.5, -0.7, -0.5], "irradiance": 1.0}]})");
   const SceneContext ctx(scene);
-  MfsSettings ms = mfs_settings_from_json(nlohmann::json::object(), "test");
-  ms.large_angle_scatters = 0;
-  ms.beam_photons = 0;
-  const MfsIntegrator mfs(ctx, ms);
-  const std::vector<const PhaseSplit*> splits{&mfs.split(0)};
-  const std::vector<double> f{mfs.split(0).f()};
-  std::vector<TransmittanceGrid> full, reduced;
-  TransmittanceGrid::build_pair(ctx.media, ctx.majorants, ctx.lights[0], 32, 0.25, f, &full.emplace_back(),
-                                &reduced.emplace_back());
+  const BeamInputs inputs(ctx);
+  const auto& splits = inputs.splits;
+  const auto& f = inputs.f;
+  const auto& full = inputs.full;
+  const auto& reduced = inputs.reduced;
   constexpr int kSeeds = 6, kPoints = 400;
   std::vector<Vec3> in, out;
   Rng rng(5, 0);
@@ -928,21 +939,12 @@ TEST(Mfs, BeamGridKeepsOneChannelForGreyMediaAndGreyLights) {
   };
   const Scene grey = scene_with("[1, 0.5, 2]", "3.0"), blue0 = scene_with("[1, 0.5, 0]", "3.0");
   const Scene chromatic = scene_with("[1, 0.5, 2]", "[3.0, 2.5, 2.0]");
-  MfsSettings ms = mfs_settings_from_json(nlohmann::json::object(), "test");
-  ms.large_angle_scatters = 0;
-  ms.beam_photons = 0;
   const Vec3 cam(0.0, -6.0, 0.0);
   const auto grid = [&](const Scene& scene, bool camera) {
     const SceneContext ctx(scene);
-    const MfsIntegrator mfs(ctx, ms);
-    const std::vector<const PhaseSplit*> splits{&mfs.split(0)};
-    const std::vector<double> f{mfs.split(0).f()};
-    std::vector<TransmittanceGrid> full, reduced;
-    for (const Light& light : ctx.lights)
-      TransmittanceGrid::build_pair(ctx.media, ctx.majorants, light, 32, 0.25, f, &full.emplace_back(),
-                                    &reduced.emplace_back());
-    return BeamGrid(ctx, splits, f, full, reduced, std::vector<int>(ctx.lights.size(), 4096), 24, 7, true,
-                    camera ? &cam : nullptr);
+    const BeamInputs inputs(ctx);
+    return BeamGrid(ctx, inputs.splits, inputs.f, inputs.full, inputs.reduced,
+                    std::vector<int>(ctx.lights.size(), 4096), 24, 7, true, camera ? &cam : nullptr);
   };
   EXPECT_EQ(grid(chromatic, false).channels(), 3);
   for (const bool camera : {false, true}) {
