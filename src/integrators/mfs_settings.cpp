@@ -146,6 +146,14 @@ int auto_scatter_grid_resolution(const SceneContext& ctx) {
   return std::isfinite(across) ? int(std::clamp(std::ceil(across / 1.6), 32.0, 64.0)) : 64;
 }
 
+namespace {
+// sqrt(pixels / 128^2), at least 1: how the photon grids' "auto" counts follow the whole image's size.
+double pixel_scale(const PinholeCamera& camera) {
+  const double pixels = double(camera.width()) * double(camera.height());
+  return std::sqrt(std::max(1.0, pixels / (128.0 * 128.0)));
+}
+}  // namespace
+
 // "auto" scatter-grid photons: 2^18 up to 128 x 128 pixels, then 2^18 sqrt(pixels / 128^2). A grid of N
 // photons costs c N of set-up and leaves a noise a / N in the error^2 beside mfs's bias b^2; the rest of the
 // render costs F (the march, growing with the pixels). (b^2 + a / N) (F + c N) is least at
@@ -157,8 +165,7 @@ int auto_scatter_grid_resolution(const SceneContext& ctx) {
 // (ScatterGridSettings::adaptive_photons).
 constexpr int kAutoPhotons = 1 << 18;
 int auto_photons(const PinholeCamera& camera) {
-  const double pixels = double(camera.width()) * double(camera.height());
-  const double n = double(kAutoPhotons) * std::sqrt(std::max(1.0, pixels / (128.0 * 128.0)));
+  const double n = double(kAutoPhotons) * pixel_scale(camera);
   return int(std::min(std::round(n), double(1 << 26)));
 }
 
@@ -206,8 +213,7 @@ bool camera_in_forward_peak(const SceneContext& ctx, const Light& light, double 
 // backlit r = 10 sphere and 0.77x on the r = 20 one, but 1.06x on the side-lit r = 10 sphere and 1.07x on the
 // double HG one (their error did not fall). The full image's pixels, as auto_photons.
 std::vector<int> auto_beam_photons(const SceneContext& ctx, double cut_angle) {
-  const double pixels = double(ctx.camera.width()) * double(ctx.camera.height());
-  const double scale = std::min(8.0, std::sqrt(std::max(1.0, pixels / (128.0 * 128.0))));
+  const double scale = std::min(8.0, pixel_scale(ctx.camera));
   std::vector<int> n;
   for (const Light& light : ctx.lights)
     n.push_back(camera_in_forward_peak(ctx, light, cut_angle) ? int(std::round(kAutoBeamPhotons * scale))
