@@ -19,11 +19,6 @@
 namespace nimbus {
 namespace {
 
-// Deposit samples of a flight are at most this many node spacings apart. A trilinear splat's weights
-// sum to one wherever the sample lies, so a node's share of a flight along an axis is exact at any step
-// up to one spacing; 1 (against 0.5 before) halves the deposits with no change in the validation errors
-// beyond their seed-to-seed spread (docs/benchmarks.md, issue 12).
-constexpr double kDepositStep = 1.0;
 constexpr int kMaxWideScatters = 1024;  // photons are ended after this many wide scatters (or
                                         // kMaxPhotonEvents real collisions)
 
@@ -53,21 +48,22 @@ void splat_one(float* tally, const NodeGrid& grid, const uint8_t* live, int floa
   for (int i = 0; i < count; ++i) node[i] += add[i];
 }
 
-// A flight's deposit samples, k = 0 .. n - 1 at x + w (t0 + (k + 0.5) len / n), through `splat` or
-// (with corner uniforms) `splat_one`.
+// A flight's deposit samples, k = 0 .. n - 1 at x + w (t0 + (k + offset) len / n), offset in [0, 1),
+// through `splat` or (with corner uniforms) `splat_one`.
 void splat_flight(float* tally, const NodeGrid& grid, const uint8_t* live, int floats_per_node, int first,
-                  int count, const Vec3& x, const Vec3& w, double t0, double len, int n, const float* add,
-                  CornerUniforms* corners) {
+                  int count, const Vec3& x, const Vec3& w, double t0, double len, int n, double offset,
+                  const float* add, CornerUniforms* corners) {
   if (!corners) {
     for (int k = 0; k < n; ++k)
-      splat(tally, grid, live, floats_per_node, first, count, x + w * (t0 + (k + 0.5) * len / n), add);
+      splat(tally, grid, live, floats_per_node, first, count, x + w * (t0 + (k + offset) * len / n), add);
     return;
   }
   corners->start_flight();
   for (int k = 0; k < n; ++k) {
     double u[3];
     corners->next(k, u);
-    splat_one(tally, grid, live, floats_per_node, first, count, x + w * (t0 + (k + 0.5) * len / n), u, add);
+    splat_one(tally, grid, live, floats_per_node, first, count, x + w * (t0 + (k + offset) * len / n), u,
+              add);
   }
 }
 
@@ -83,17 +79,18 @@ struct TallyBlock {
 };
 
 // Track-length deposit of the flight x + t w, t in [0, t_end] (clipped to the node grid): samples at
-// most kDepositStep spacings apart, each splatting its share of power x length times the harmonics of w
+// most `step` node spacings apart, at `offset` within each equal part of the clipped flight
+// (ScatterGridSettings::deposit_step), each splatting its share of power x length times the harmonics of w
 // (into block.mono when given; else into the RGB block `tally`, where only the channels from the first
 // to the last with non-zero power are touched); trilinearly, or with `corners` to one node per sample.
 void deposit_flight(float* tally, const TallyBlock& block, const NodeGrid& grid, const uint8_t* live,
-                    int bands, const Vec3& x, const Vec3& w, double t_end, const Rgb& power,
-                    CornerUniforms* corners) {
+                    int bands, const Vec3& x, const Vec3& w, double t_end, const Rgb& power, double step,
+                    double offset, CornerUniforms* corners) {
   double t0, t1;
   if (!grid.bounds.intersect(x, w, 0.0, t_end, &t0, &t1)) return;
   const double len = t1 - t0;
   if (!(len > 0.0)) return;
-  const int n = std::max(1, int(std::ceil(len / (kDepositStep * grid.min_spacing()))));
+  const int n = std::max(1, int(std::ceil(len / (step * grid.min_spacing()))));
   const Rgb v = power * (len / n);
   NIMBUS_DCHECK(min_component(v) >= 0.0 && std::isfinite(max_component(v)));
   const int coeffs = bands * bands;
@@ -107,7 +104,7 @@ void deposit_flight(float* tally, const TallyBlock& block, const NodeGrid& grid,
     sh_eval(w, bands, y);
     float add[kShMaxBands * kShMaxBands];
     for (int h = 0; h < coeffs; ++h) add[h] = float(a * y[h]);
-    splat_flight(block.mono, grid, live, coeffs, 0, coeffs, x, w, t0, len, n, add, corners);
+    splat_flight(block.mono, grid, live, coeffs, 0, coeffs, x, w, t0, len, n, offset, add, corners);
     return;
   }
   int c_lo = 0, c_hi = 2;
@@ -119,7 +116,7 @@ void deposit_flight(float* tally, const TallyBlock& block, const NodeGrid& grid,
   for (int c = c_lo; c <= c_hi; ++c)
     for (int h = 0; h < coeffs; ++h) add[coeffs * (c - c_lo) + h] = float(v[c] * y[h]);
   const int first = coeffs * c_lo, count = coeffs * (c_hi - c_lo + 1);
-  splat_flight(tally, grid, live, 3 * coeffs, first, count, x, w, t0, len, n, add, corners);
+  splat_flight(tally, grid, live, 3 * coeffs, first, count, x, w, t0, len, n, offset, add, corners);
 }
 
 // The next pre-filtered level: the values (`floats` per node) of `fine` at its nodes 2j, filtered with
@@ -316,6 +313,12 @@ struct ScatterPhotons {
 
   void split(int photons);  // first = photon_split(..., photons, ...), and surface
   void trace(size_t j, Rng& rng, PhotonBatch& batch) const;
+  // A flight's deposit offset (deposit_flight): a uniform, one per flight, drawn also with
+  // deposit_midpoints (which takes 1/2) so that the walks are the same either way.
+  double offset(Rng& rng) const {
+    const double u = rng.uniform();
+    return s.deposit_midpoints ? 0.5 : u;
+  }
   bool reflect(const SurfaceHit& hit, Vec3* w, int c, double* weight, int* order, Rng& rng) const;
   bool bounce(const SurfaceHit& hit, Vec3* w, double* factor, Rng& rng) const;
   bool scatter(const Vec3& xc, Vec3* w, int c, double* weight, int* order, Rng& rng,
@@ -378,7 +381,8 @@ void ScatterPhotons::trace(size_t j, Rng& rng, PhotonBatch& batch) const {
       [&](const Vec3& p) { return extinction(p)[c]; },
       [&](const Vec3& x, const Vec3& w, double t_end) {
         if (order >= first_order)
-          deposit_flight(batch.tally.data(), block, grid, live, bands, x, w, t_end, power * weight, corners);
+          deposit_flight(batch.tally.data(), block, grid, live, bands, x, w, t_end, power * weight,
+                         s.deposit_step, offset(rng), corners);
       },
       [&](const Vec3& xc, Vec3* w) { return scatter(xc, w, c, &weight, &order, rng, batch); },
       [&](const SurfaceHit& hit, Vec3* w) { return reflect(hit, w, c, &weight, &order, rng); });
@@ -484,7 +488,7 @@ void ScatterPhotons::trace_hero(const Photon& ph, int hero, const Rgb& share, co
   const auto deposit = [&](const Vec3& w, double len) {
     if (order >= first_order)
       deposit_flight(batch.tally.data(), block, grid, live, bands, seg, w, len, ph.power * walk.weight(),
-                     corners);
+                     s.deposit_step, offset(rng), corners);
   };
   Vec3 dir = ph.w;  // the current flight's direction
   walk_photon(
