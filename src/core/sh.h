@@ -13,9 +13,30 @@ namespace nimbus {
 
 inline constexpr int kShMaxBands = 6;
 
+// The normalisations of sh_eval, per (l, m), m <= l: K_lm = sqrt((2l + 1) / (4 pi) (l - m)! / (l + m)!),
+// times sqrt(2) for m != 0; and (-1)^m (2m - 1)!!, where the recurrence for Q_l^m starts. Found once
+// (the same operations as per call before: sh_eval's values are the same bits).
+struct ShFactors {
+  double k[kShMaxBands][kShMaxBands] = {};
+  double q0[kShMaxBands] = {};
+  ShFactors() {
+    for (int m = 0; m < kShMaxBands; ++m) {
+      double q = 1.0;
+      for (int i = 1; i <= m; ++i) q *= -(2.0 * i - 1.0);
+      q0[m] = q;
+      for (int l = m; l < kShMaxBands; ++l) {
+        double ratio = 1.0;  // (l - m)! / (l + m)!
+        for (int i = l - m + 1; i <= l + m; ++i) ratio /= i;
+        const double K = std::sqrt((2.0 * l + 1.0) / (4.0 * kPi) * ratio);
+        k[l][m] = m == 0 ? K : std::sqrt(2.0) * K;
+      }
+    }
+  }
+};
+
 // y[0 .. bands^2) for 1 <= bands <= kShMaxBands.
 inline void sh_eval(const Vec3& w, int bands, double* y) {
-  // Normalisation K_lm = sqrt((2l + 1) / (4 pi) (l - m)! / (l + m)!), times sqrt(2) for m != 0.
+  static const ShFactors f;
   double A[kShMaxBands], B[kShMaxBands];  // Re, Im of (x + i y)^m
   A[0] = 1.0;
   B[0] = 0.0;
@@ -25,8 +46,7 @@ inline void sh_eval(const Vec3& w, int bands, double* y) {
   }
   for (int m = 0; m < bands; ++m) {
     // Q_l^m(z) = P_l^m(z) / (1 - z^2)^(m/2) for l = m, m+1, ...
-    double q_prev = 0.0, q = 1.0;
-    for (int k = 1; k <= m; ++k) q *= -(2.0 * k - 1.0);  // (-1)^m (2m - 1)!!
+    double q_prev = 0.0, q = f.q0[m];
     for (int l = m; l < bands; ++l) {
       if (l == m + 1) {
         q_prev = q;
@@ -36,14 +56,11 @@ inline void sh_eval(const Vec3& w, int bands, double* y) {
         q_prev = q;
         q = next;
       }
-      double ratio = 1.0;  // (l - m)! / (l + m)!
-      for (int k = l - m + 1; k <= l + m; ++k) ratio /= k;
-      const double K = std::sqrt((2.0 * l + 1.0) / (4.0 * kPi) * ratio);
       if (m == 0) {
-        y[l * l + l] = K * q;
+        y[l * l + l] = f.k[l][0] * q;
       } else {
-        y[l * l + l + m] = std::sqrt(2.0) * K * q * A[m];
-        y[l * l + l - m] = std::sqrt(2.0) * K * q * B[m];
+        y[l * l + l + m] = f.k[l][m] * q * A[m];
+        y[l * l + l - m] = f.k[l][m] * q * B[m];
       }
     }
   }
