@@ -87,11 +87,11 @@ struct ScatterGridSettings {
   Splat splat = Splat::trilinear;
   // A flight's track-length deposit: samples at most deposit_step node spacings apart, one in each equal
   // part of the flight (clipped to the grid) at an offset drawn once per flight, so that each is unbiased
-  // for its part's integral of the trilinear weights at any step. At the parts' midpoints
-  // (deposit_midpoints, for tests) they are not where the flights' density changes within a step (at the
-  // media's sides): at 3 and 4 spacings the midpoints darkened the side-lit r = 10 sphere by 0.5 and
-  // 1.2 points. 2 (against midpoints 1 spacing apart before) halves the samples of long flights for 0-2 %
-  // more binned error (docs/benchmarks.md, "Jittered deposit samples").
+  // for its part's integral of the trilinear weights at any step. Samples at the parts' midpoints
+  // (deposit_midpoints, for tests) are not, where the flights' density changes within a step (at the
+  // media's sides): at 3 and 4 spacings they darkened the side-lit r = 10 sphere by 0.5 and 1.2 points.
+  // 2 (against midpoints 1 spacing apart before) halves the samples of long flights for at most 1 % more
+  // binned error with the same photons (docs/benchmarks.md, "Jittered deposit samples").
   double deposit_step = 2.0;
   bool deposit_midpoints = false;
   uint64_t seed = 1;
