@@ -306,9 +306,12 @@ struct ScatterPhotons {
   const EmissionSampler* emission;  // null when no medium emits
   Vec3 centre;                      // of the media's bounding sphere, which the photons are aimed at
   double radius;
-  SurfaceEmission surface;          // with surfaces: emit_with_surfaces' start and far planes
-  int K;                            // flights after wide scatter 1 .. K - 1 are kept
-  double majorant_scale;            // the share of the majorant that bounds the extinction the photons see
+  SurfaceEmission surface;  // with surfaces: emit_with_surfaces' start and far planes
+  int K;                    // flights after wide scatter 1 .. K - 1 are kept
+  double majorant_scale;    // the share of the majorant that bounds the extinction the photons see
+  // The photons fly over the exact piece of one constant-density shape of grey extinction (walk_photon's
+  // `pieces`, the full extinction): its majorant is the extinction wherever a tentative collision falls.
+  bool exact_pieces;
   std::vector<SourceBlock> blocks;  // per source, as trace numbers them
 
   void split(int photons);  // first = photon_split(..., photons, ...), and surface
@@ -378,7 +381,12 @@ void ScatterPhotons::trace(size_t j, Rng& rng, PhotonBatch& batch) const {
   int order = 0;  // wide scatters so far
   walk_photon(
       ctx, s.majorants ? *s.majorants : ctx.majorants, ph.x, ph.w, majorant_scale, rng, &batch.collisions,
-      [&](const Vec3& p) { return extinction(p)[c]; },
+      [&](const Vec3& p, double maj) {
+        // Over one grey constant-density shape's exact piece every tentative collision is real (sigma =
+        // maj): the uniform is drawn as for any other, the density is not looked up (exact_pieces).
+        const double sigma = exact_pieces ? maj : extinction(p)[c];
+        return rng.uniform() * maj < sigma;
+      },
       [&](const Vec3& x, const Vec3& w, double t_end) {
         if (order >= first_order)
           deposit_flight(batch.tally.data(), block, grid, live, bands, x, w, t_end, power * weight,
@@ -657,6 +665,17 @@ int adaptive_photon_count(const ScatterGridSettings& s, double collisions) {
   return std::max(s.photons, int(std::min(std::round(double(s.adaptive_photons) * factor), double(1 << 26))));
 }
 
+// Whether the photons fly over the exact piece of one constant-density shape (walk_photon's `pieces`: the
+// scene's analytic media and majorants) with the full, grey extinction: then every tentative collision is
+// a real one (ScatterPhotons::exact_pieces).
+bool exact_pieces(const SceneContext& ctx, const ScatterGridSettings& s) {
+  if (!ctx.analytic.active() || (s.majorants && s.majorants != &ctx.majorants) || !s.exact_transport ||
+      ctx.media.count() != 1)
+    return false;
+  const Rgb sigma_t = ctx.media.medium(0).sigma_s + ctx.media.medium(0).sigma_a;
+  return sigma_t.x == sigma_t.y && sigma_t.y == sigma_t.z;
+}
+
 }  // namespace
 
 ScatterGrid::ScatterGrid(const SceneContext& ctx, const std::vector<const PhaseSplit*>& splits,
@@ -692,7 +711,6 @@ void ScatterGrid::trace(const SceneContext& ctx, const std::vector<const PhaseSp
   const EmissionSampler emission = scatters ? EmissionSampler(ctx.media) : EmissionSampler();
   const size_t sources = lights + (ctx.has_environment ? 1 : 0) + (emission.active() ? 1 : 0);
   if (sources == 0 || s.photons <= 0) return;
-
   const Bounds media_bounds = ctx.media.bounds();
   const Vec3 extent = media_bounds.hi - media_bounds.lo;
   ScatterPhotons photons{
@@ -714,6 +732,7 @@ void ScatterGrid::trace(const SceneContext& ctx, const std::vector<const PhaseSp
       .K = s.max_wide_scatters <= 0 ? kMaxWideScatters : std::min(s.max_wide_scatters, kMaxWideScatters),
       .majorant_scale =
           s.exact_transport ? 1.0 : majorant_share(ctx.media, [&](int i) { return 1.0 - peak_fraction[i]; }),
+      .exact_pieces = exact_pieces(ctx, s),
       .blocks = {}};
   const std::vector<uint8_t> live = s.live_nodes_only
                                         ? live_nodes(grid_, s.majorants ? *s.majorants : ctx.majorants)
