@@ -609,6 +609,16 @@ struct BeamInputs {
       TransmittanceGrid::build_pair(ctx.media, ctx.majorants, light, 32, 0.25, f, &full.emplace_back(),
                                     &reduced.emplace_back());
   }
+  // A beam grid over these inputs: BeamGrid's arguments after the splits, f and the light maps.
+  template <typename... Rest>
+  BeamGrid grid(const SceneContext& ctx, Rest&&... rest) const {
+    return BeamGrid(ctx, splits, f, full, reduced, std::forward<Rest>(rest)...);
+  }
+  // g's lookup at p for light l with the light's maps read at p.
+  bool lookup(const BeamGrid& g, size_t l, const Vec3& p, Rgb* R, Rgb* mean_cosine = nullptr,
+              Rgb* peak_toward = nullptr) const {
+    return g.lookup(l, p, full[l].lookup(p), reduced[l].lookup(p), R, mean_cosine, peak_toward);
+  }
   MfsIntegrator mfs;
   std::vector<const PhaseSplit*> splits;
   std::vector<double> f;
@@ -629,15 +639,10 @@ TEST(Mfs, BeamGridSkipsIdleCellsWithoutChangingTheMedia) {
                {"type": "point", "position": [-3, -1.5, 0.5], "intensity": 2.0}]})");
   const SceneContext ctx(scene);
   const BeamInputs inputs(ctx);
-  const auto& splits = inputs.splits;
-  const auto& f = inputs.f;
-  const auto& full = inputs.full;
-  const auto& reduced = inputs.reduced;
   const Vec3 cam(0.0, -6.0, 0.0);
-  const BeamGrid skip(ctx, splits, f, full, reduced, std::vector<int>(ctx.lights.size(), 4096), 40, 7, true,
-                      &cam, nullptr, true);
-  const BeamGrid all(ctx, splits, f, full, reduced, std::vector<int>(ctx.lights.size(), 4096), 40, 7, true,
-                     &cam, nullptr, false);
+  const std::vector<int> photons(ctx.lights.size(), 4096);
+  const BeamGrid skip = inputs.grid(ctx, photons, 40, 7, true, &cam, nullptr, true);
+  const BeamGrid all = inputs.grid(ctx, photons, 40, 7, true, &cam, nullptr, false);
   std::printf("beam grid: idle share of the cells %.3f\n", skip.idle_share());
   EXPECT_GT(skip.idle_share(), 0.2);
   EXPECT_EQ(all.idle_share(), 0.0);
@@ -650,9 +655,8 @@ TEST(Mfs, BeamGridSkipsIdleCellsWithoutChangingTheMedia) {
     const bool in_gap = std::abs(x) < 0.5;
     for (size_t l = 0; l < 2; ++l) {
       Rgb R[2], mc[2], pk[2];
-      const Rgb T_light = full[l].lookup(p), T_wide = reduced[l].lookup(p);
-      ASSERT_TRUE(skip.lookup(l, p, T_light, T_wide, &R[0], &mc[0], &pk[0]));
-      ASSERT_TRUE(all.lookup(l, p, T_light, T_wide, &R[1], &mc[1], &pk[1]));
+      ASSERT_TRUE(inputs.lookup(skip, l, p, &R[0], &mc[0], &pk[0]));
+      ASSERT_TRUE(inputs.lookup(all, l, p, &R[1], &mc[1], &pk[1]));
       for (int c = 0; c < 3; ++c) {
         if (in_media) {
           EXPECT_EQ(R[0][c], R[1][c]) << "light " << l << " at " << x << " " << y << " " << z;
@@ -688,18 +692,15 @@ TEST(Mfs, BeamGridStraightLineEndsAtSurfaces) {
     "lights": [{"type": "directional", "direction": [0, 0, -1], "irradiance": 1.0}]})");
   const SceneContext ctx(scene);
   const BeamInputs inputs(ctx);
-  const auto& splits = inputs.splits;
-  const auto& f = inputs.f;
-  const auto& full = inputs.full;
-  const auto& reduced = inputs.reduced;
-  const BeamGrid g(ctx, splits, f, full, reduced, {1 << 14}, 32, 3, false);
-  const BeamGrid smoothed(ctx, splits, f, full, reduced, {1 << 14}, 32, 3, false, nullptr, nullptr, true, 2);
+  const std::vector<int> photons{1 << 14};
+  const BeamGrid g = inputs.grid(ctx, photons, 32, 3, false);
+  const BeamGrid smoothed = inputs.grid(ctx, photons, 32, 3, false, nullptr, nullptr, true, 2);
   double beside = 0.0;  // the smoothed grid's mean R one to two node spacings (0.13) beside the shadow
   for (int i = 0; i < 40; ++i)
     for (const double x : {0.15, 0.25}) {
       const Vec3 p(x, -1.5 + 3.0 * i / 39.0, 0.0);
       Rgb R;
-      ASSERT_TRUE(smoothed.lookup(0, p, full[0].lookup(p), reduced[0].lookup(p), &R, nullptr));
+      ASSERT_TRUE(inputs.lookup(smoothed, 0, p, &R));
       beside += R[0] / 80.0;
     }
   double shade_min = 2.0, lit_mean = 0.0;
@@ -708,9 +709,9 @@ TEST(Mfs, BeamGridStraightLineEndsAtSurfaces) {
     for (const double z : {-0.5, 0.0, 0.5}) {
       Rgb R;
       const Vec3 shade(-1.2, y, z), lit(1.2, y, z);
-      ASSERT_TRUE(g.lookup(0, shade, full[0].lookup(shade), reduced[0].lookup(shade), &R, nullptr));
+      ASSERT_TRUE(inputs.lookup(g, 0, shade, &R));
       shade_min = std::min(shade_min, R[0]);
-      ASSERT_TRUE(g.lookup(0, lit, full[0].lookup(lit), reduced[0].lookup(lit), &R, nullptr));
+      ASSERT_TRUE(inputs.lookup(g, 0, lit, &R));
       lit_mean += R[0] / 120.0;
     }
   }
@@ -780,10 +781,6 @@ TEST(Mfs, BeamGridSmoothingAveragesTheNoiseInsideTheMediaOnly) {
     "lights": [{"type": "directional", "direction": [-0.5, -0.7, -0.5], "irradiance": 1.0}]})");
   const SceneContext ctx(scene);
   const BeamInputs inputs(ctx);
-  const auto& splits = inputs.splits;
-  const auto& f = inputs.f;
-  const auto& full = inputs.full;
-  const auto& reduced = inputs.reduced;
   constexpr int kSeeds = 6, kPoints = 400;
   std::vector<Vec3> in, out;
   Rng rng(5, 0);
@@ -800,20 +797,21 @@ TEST(Mfs, BeamGridSmoothingAveragesTheNoiseInsideTheMediaOnly) {
   // R at the points, per smoothing (0: raw, 1: smoothed) and seed.
   std::array<std::vector<double>, 2> R_in;
   for (int seed = 0; seed < kSeeds; ++seed) {
-    const BeamGrid raw(ctx, splits, f, full, reduced, {1 << 13}, 32, uint64_t(seed + 1), false);
-    const BeamGrid smoothed(ctx, splits, f, full, reduced, {1 << 13}, 32, uint64_t(seed + 1), false, nullptr,
-                            nullptr, true, 2);
+    const std::vector<int> photons{1 << 13};
+    const BeamGrid raw = inputs.grid(ctx, photons, 32, uint64_t(seed + 1), false);
+    const BeamGrid smoothed =
+        inputs.grid(ctx, photons, 32, uint64_t(seed + 1), false, nullptr, nullptr, true, 2);
     const BeamGrid* grids[2] = {&raw, &smoothed};
     for (int s = 0; s < 2; ++s)
       for (const Vec3& p : in) {
         Rgb R;
-        ASSERT_TRUE(grids[s]->lookup(0, p, full[0].lookup(p), reduced[0].lookup(p), &R, nullptr));
+        ASSERT_TRUE(inputs.lookup(*grids[s], 0, p, &R));
         R_in[s].push_back(R[0]);
       }
     for (const Vec3& p : out) {
       Rgb a, b;
-      ASSERT_TRUE(smoothed.lookup(0, p, full[0].lookup(p), reduced[0].lookup(p), &a, nullptr));
-      ASSERT_TRUE(raw.lookup(0, p, full[0].lookup(p), reduced[0].lookup(p), &b, nullptr));
+      ASSERT_TRUE(inputs.lookup(smoothed, 0, p, &a));
+      ASSERT_TRUE(inputs.lookup(raw, 0, p, &b));
       EXPECT_EQ(a[0], b[0]) << "outside at " << p.x << " " << p.y;
       outside_read += b[0] != 1.0;
     }
@@ -943,8 +941,7 @@ TEST(Mfs, BeamGridKeepsOneChannelForGreyMediaAndGreyLights) {
   const auto grid = [&](const Scene& scene, bool camera) {
     const SceneContext ctx(scene);
     const BeamInputs inputs(ctx);
-    return BeamGrid(ctx, inputs.splits, inputs.f, inputs.full, inputs.reduced,
-                    std::vector<int>(ctx.lights.size(), 4096), 24, 7, true, camera ? &cam : nullptr);
+    return inputs.grid(ctx, std::vector<int>(ctx.lights.size(), 4096), 24, 7, true, camera ? &cam : nullptr);
   };
   EXPECT_EQ(grid(chromatic, false).channels(), 3);
   for (const bool camera : {false, true}) {
