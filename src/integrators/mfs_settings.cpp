@@ -128,10 +128,25 @@ std::optional<MajorantGrid> photon_majorant_grid(const SceneContext& ctx, const 
   return std::optional<MajorantGrid>(std::in_place, ctx.media, std::max({r[0], r[1], r[2]}), false, true);
 }
 
-// "auto" scatter-grid resolution: cells of at most ~1.6 optical depths at the medium's typical
-// extinction (the mean of the majorant grid's non-empty cells), 32 to 64 nodes along the longest axis:
-// 32 up to an optical size of ~50 across. (A uniform medium's whole extinction; a cloud's dense core
-// counts less.)
+namespace {
+// sqrt(pixels / 128^2), at least 1: how the photon grids' "auto" counts follow the whole image's size.
+double pixel_scale(const PinholeCamera& camera) {
+  const double pixels = double(camera.width()) * double(camera.height());
+  return std::sqrt(std::max(1.0, pixels / (128.0 * 128.0)));
+}
+}  // namespace
+
+// "auto" scatter-grid (and beam-grid) resolution: from 512 x 512 pixels on, cells of at most ~1.6 optical
+// depths at the medium's typical extinction (the mean of the majorant grid's non-empty cells), 32 to 64
+// nodes along the longest axis (32 up to an optical size of ~50 across); smaller images take that times
+// 7/8 up to 128 x 128 pixels, 1/32 more per doubling of the width between (the full image's pixels, as
+// auto_photons): 28 nodes for the small media at 128 x 128. A grid of spacing h blurs the photons' light
+// by its deposit and lookup tents, a bias ~h^2 (the side-lit r = 10 sphere's mean with 2^22 photons:
+// -2.2, -1.5, -1.0, -0.6 % at 24, 32, 48 and 96 nodes), and its noise variance goes as
+// 1 / (photons h^3): the larger images' photons (auto_photons) buy a finer grid. Measured
+// (docs/benchmarks.md, "The grids' resolution by image size"): at 128 x 128, 28 against 32 nodes gives
+// 0.87x error^2 x CPU over the suite's spheres and box (10 seeds), 48 against 55 0.84x on the Disney
+// cloud (6 seeds); at 512 x 512, 28 and 32 are the same and 40 is worse.
 int auto_scatter_grid_resolution(const SceneContext& ctx) {
   const Bounds b = ctx.media.bounds();
   double sum = 0.0;
@@ -143,16 +158,10 @@ int auto_scatter_grid_resolution(const SceneContext& ctx) {
         if (const double m = ctx.majorants.cell_majorant(x, y, z); m > 0.0) sum += m, ++cells;
   const Vec3 e = b.empty() ? Vec3(0.0) : b.hi - b.lo;
   const double across = cells > 0 ? std::max({e.x, e.y, e.z}) * sum / double(cells) : 0.0;
-  return std::isfinite(across) ? int(std::clamp(std::ceil(across / 1.6), 32.0, 64.0)) : 64;
+  const double nodes = std::isfinite(across) ? std::clamp(std::ceil(across / 1.6), 32.0, 64.0) : 64.0;
+  const double scale = std::min(1.0, (28.0 + 2.0 * std::log2(pixel_scale(ctx.camera))) / 32.0);
+  return int(std::round(nodes * scale));
 }
-
-namespace {
-// sqrt(pixels / 128^2), at least 1: how the photon grids' "auto" counts follow the whole image's size.
-double pixel_scale(const PinholeCamera& camera) {
-  const double pixels = double(camera.width()) * double(camera.height());
-  return std::sqrt(std::max(1.0, pixels / (128.0 * 128.0)));
-}
-}  // namespace
 
 // "auto" scatter-grid photons: 2^18 up to 128 x 128 pixels, then 2^18 sqrt(pixels / 128^2). A grid of N
 // photons costs c N of set-up and leaves a noise a / N in the error^2 beside mfs's bias b^2; the rest of the

@@ -6,7 +6,9 @@
 #include <algorithm>
 #include <cstring>
 
+#include "integrators/mfs_settings.h"
 #include "nimbus/render.h"
+#include "scene/context.h"
 #include "support/scenes.h"
 
 namespace nimbus {
@@ -35,7 +37,7 @@ TEST(RenderSettings, AutoChoicesAreResolvedInTheHeader) {
       settings_sphere_scene(R"({"type": "mfs", "spp": 1, "photons": 4096, "beam_photons": 1024})");
   const RenderResult r = render(scene);
   ASSERT_TRUE(r.settings["scatter_grid_resolution"].is_number_integer());
-  EXPECT_GE(r.settings["scatter_grid_resolution"].get<int>(), 32);
+  EXPECT_GE(r.settings["scatter_grid_resolution"].get<int>(), 28);
   EXPECT_LE(r.settings["scatter_grid_resolution"].get<int>(), 64);
   EXPECT_EQ(r.settings["type"], "mfs");
   EXPECT_EQ(r.settings["photons"], 4096);
@@ -49,6 +51,28 @@ TEST(RenderSettings, AutoChoicesAreResolvedInTheHeader) {
   ASSERT_EQ(r2.image.rgb.size(), r.image.rgb.size());
   EXPECT_EQ(std::memcmp(r2.image.rgb.data(), r.image.rgb.data(), r.image.rgb.size() * sizeof(float)), 0);
   EXPECT_EQ(r2.settings, r.settings);
+}
+
+// The "auto" grid resolution: cells of ~1.6 optical depths, 32 to 64 nodes, from 512 x 512 pixels on;
+// 7/8 of that up to 128 x 128, 1/32 more per doubling of the width between.
+TEST(RenderSettings, AutoGridResolutionFollowsTheImageAndTheOpticalSize) {
+  const std::string mfs = R"({"type": "mfs", "spp": 1})";
+  struct Case {
+    int width, height, thin, thick, thicker;
+  };
+  // Extinction 3.1, 30.1 and 60.1 over a diameter of 2: 32, 38 (60.2 / 1.6) and 64 (75.1, clamped) nodes
+  // from 512 x 512 on.
+  for (const Case c :
+       {Case{8, 6, 28, 33, 56}, Case{128, 128, 28, 33, 56}, Case{181, 181, 29, 34, 58},
+        Case{256, 256, 30, 36, 60}, Case{512, 512, 32, 38, 64}, Case{1920, 1080, 32, 38, 64}}) {
+    const auto nodes = [&](double sigma_s) {
+      return auto_scatter_grid_resolution(
+          SceneContext(settings_sphere_scene(mfs, c.width, c.height, sigma_s)));
+    };
+    EXPECT_EQ(nodes(3.0), c.thin) << c.width << "x" << c.height;
+    EXPECT_EQ(nodes(30.0), c.thick) << c.width << "x" << c.height;
+    EXPECT_EQ(nodes(60.0), c.thicker) << c.width << "x" << c.height;
+  }
 }
 
 // "auto" photons: 2^18 up to 128 x 128 pixels, then 2^18 sqrt(pixels / 128^2), from the whole image's pixels,
