@@ -167,8 +167,14 @@ struct Surface {
 // best error per second. pathtrace's error falls as 1 / sqrt(spp) at a cost in proportion to spp (any
 // spp has the same efficiency; 64 is a first look); the deterministic marches' error is mostly their
 // bias, which more samples do not reduce: 4 spp (anti-aliasing and the march's jitter) is where their
-// error stops falling on the validation suite (docs/validation/render.md).
-inline int default_spp(const std::string& integrator) { return integrator == "pathtrace" ? 64 : 4; }
+// error stops falling on the validation suite (docs/validation/render.md). `mfs`'s error is its bias and
+// its photon grids' noise, fixed per render: over the suite at 128 x 128 its error^2 x CPU is least at
+// 1 spp in 4 x 4-pixel bins and at 2-4 spp pixel by pixel; 2 spp is within 20 % of the best in bins on
+// all nine scenes and within 25 % pixel by pixel on eight, 4 spp up to 64 % off in bins
+// (docs/benchmarks.md, "`mfs`'s default spp").
+inline int default_spp(const std::string& integrator) {
+  return integrator == "pathtrace" ? 64 : integrator == "mfs" ? 2 : 4;
+}
 
 struct IntegratorSettings {
   std::string type = "pathtrace";

@@ -196,5 +196,18 @@ TEST(RenderSettings, OverridesAreWhatTheHeaderSays) {
   EXPECT_EQ(same.settings["peak_fraction"], "auto");
 }
 
+// A scene without spp renders its integrator's default (include/nimbus/scene.h, default_spp: the best
+// error per second), and an integrator switched on the command line takes its own, not the scene's.
+TEST(RenderSettings, AnIntegratorWithoutSppTakesItsOwnDefault) {
+  const Scene scene = settings_sphere_scene(R"({"type": "pathtrace"})", 4, 3);
+  ASSERT_FALSE(scene.integrator.spp_given);
+  RenderOptions o;
+  o.integrator = "mfs";
+  const RenderResult r = render(scene, o);
+  EXPECT_EQ(r.settings["spp"], default_spp("mfs"));
+  EXPECT_EQ(meta(r, "nimbus/spp"), std::to_string(default_spp("mfs")));
+  EXPECT_NE(default_spp("mfs"), default_spp("pathtrace"));
+}
+
 }  // namespace
 }  // namespace nimbus
