@@ -666,14 +666,16 @@ int adaptive_photon_count(const ScatterGridSettings& s, double collisions) {
 }
 
 // Whether the photons fly over the exact piece of one constant-density shape (walk_photon's `pieces`: the
-// scene's analytic media and majorants) with the full, grey extinction: then every tentative collision is
-// a real one (ScatterPhotons::exact_pieces).
+// scene's analytic media and majorants) with the full, grey extinction as its majorant: then every
+// tentative collision is a real one (ScatterPhotons::exact_pieces). Not for a lone pure absorber, whose
+// piece's majorant is twice its extinction (AnalyticMedia).
 bool exact_pieces(const SceneContext& ctx, const ScatterGridSettings& s) {
   if (!ctx.analytic.active() || (s.majorants && s.majorants != &ctx.majorants) || !s.exact_transport ||
       ctx.media.count() != 1)
     return false;
-  const Rgb sigma_t = ctx.media.medium(0).sigma_s + ctx.media.medium(0).sigma_a;
-  return sigma_t.x == sigma_t.y && sigma_t.y == sigma_t.z;
+  const Medium& m = ctx.media.medium(0);
+  const Rgb sigma_t = m.sigma_s + m.sigma_a;
+  return max_component(m.sigma_s) > 0.0 && sigma_t.x == sigma_t.y && sigma_t.y == sigma_t.z;
 }
 
 }  // namespace

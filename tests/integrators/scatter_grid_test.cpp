@@ -208,15 +208,19 @@ TEST(ScatterGrid, JitteredDepositsKeepTheTrackLengthIntegral) {
 // On constant-density shapes the photons fly over the shapes' exact pieces (one exponential step per
 // collision) instead of cell by cell of the majorant grid: the same walks in distribution, so grids of
 // the same mean over seeds within their noise (a z-test of the difference, 4 standard errors), and not
-// the same grids (the other path was taken). The same for a box lit from the side and a sphere with a
-// sky (photons entering from every side).
+// the same grids (the other path was taken). The same for a box lit from the side, a sphere with a
+// sky (photons entering from every side) and a lone pure absorber under a sky (whose pieces' majorant is
+// twice its extinction: AnalyticMedia; the sky's flights are deposited from their entry).
 TEST(ScatterGrid, PhotonsOverAnalyticPiecesKeepTheMean) {
   const Scene sphere = split_scene(true);
   const Scene box = test::scene_from_json("{" + test::camera_json(8, 8, 40.0) + R"(,
     "media": [{"shape": {"type": "box", "min": [-0.7, -0.6, -0.8], "max": [0.7, 0.6, 0.8]}, "sigma_s": 6.0,
                "sigma_a": 0.05, "phase": {"type": "hg", "g": 0.85}}],
     "lights": [{"type": "directional", "direction": [-1, 0.3, 0.2], "irradiance": 3.0}]})");
-  for (const Scene* scene : {&sphere, &box}) {
+  const Scene absorber = test::scene_from_json("{" + test::camera_json(8, 8, 40.0) + R"(,
+    "media": [{"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1}, "sigma_s": 0.0, "sigma_a": 2.0}],
+    "lights": [{"type": "environment", "radiance": 0.5}]})");
+  for (const Scene* scene : {&sphere, &box, &absorber}) {
     const SceneContext pieces(*scene);
     SceneContext cells(*scene);
     ASSERT_TRUE(pieces.analytic.active());
