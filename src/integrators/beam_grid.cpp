@@ -46,6 +46,14 @@ void smooth_nodes_inside(FloatArray* v, const NodeGrid& g, const std::vector<uin
     }
 }
 
+std::vector<uint8_t> nodes_inside(const NodeGrid& g, const SceneMedia& media) {
+  std::vector<uint8_t> in(g.size(), 0);
+  for (int z = 0; z < g.nodes[2]; ++z)
+    for (int y = 0; y < g.nodes[1]; ++y)
+      for (int x = 0; x < g.nodes[0]; ++x) in[g.index(x, y, z)] = media.inside(g.position(x, y, z));
+  return in;
+}
+
 namespace {
 
 // Per node, blocks of `channels` floats (3: rgb; 1: grey media under lights of grey strength, whose three
@@ -148,15 +156,6 @@ std::vector<uint8_t> idle_cells(const NodeGrid& g, const MajorantGrid& maj, bool
             for (int i = lo[0]; i <= hi[0]; ++i) idle[(size_t(k) * cells[1] + j) * cells[0] + i] = 0;
       }
   return idle;
-}
-
-// Per node: 1 where a medium has a density at the node itself.
-std::vector<uint8_t> nodes_inside(const NodeGrid& g, const SceneMedia& media) {
-  std::vector<uint8_t> in(g.size(), 0);
-  for (int z = 0; z < g.nodes[2]; ++z)
-    for (int y = 0; y < g.nodes[1]; ++y)
-      for (int x = 0; x < g.nodes[0]; ++x) in[g.index(x, y, z)] = media.inside(g.position(x, y, z));
-  return in;
 }
 
 // Where a node's straight tally is 0 in a channel (a surface's shadow: the straight line ended at the

@@ -95,5 +95,7 @@ class BeamGrid {
 // left out and the weights renormalised; the nodes outside keep their values. (BeamGrid's smoothing.)
 void smooth_nodes_inside(FloatArray* v, const NodeGrid& g, const std::vector<uint8_t>& inside, int stride,
                          int passes);
+// Per node of g: 1 where a medium has a density at the node itself.
+std::vector<uint8_t> nodes_inside(const NodeGrid& g, const SceneMedia& media);
 
 }  // namespace nimbus

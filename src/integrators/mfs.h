@@ -43,6 +43,7 @@
 // | `channel_passes`          | boolean                       | false     | chromatic media: one scatter grid photon pass per colour channel (each with its own coefficients) instead of one pass of hero-channel photons carrying all three (scatter_grid.h) |
 // | `scatter_grid_resolution` | "auto" or integer in [4, 96]  | "auto"    | scatter and beam grid nodes along the longest axis ("auto": ~1.6 optical depths per cell, 32 to 64, from 512 x 512 pixels on; 7/8 of that up to 128 x 128; the header of a rendered image holds the number chosen) |
 // | `scatter_grid_bands`      | integer in [1, 3]             | 3         | spherical-harmonic bands used at lookup (l < bands) |
+// | `grid_denoise`            | boolean                       | true      | the scatter grid's nodes inside the media filtered where their difference from their neighbours is photon noise, by the photon batches' spread (grid_denoise.h) |
 // | `forward_side`            | "camera" or "light"           | "camera"  | peak scatters after the last wide scatter carried to the camera, or taken on the light's side with an exact camera leg |
 // | `beam_photons`            | "auto" or integer in [0, 2^24] | "auto"  | photons per light for the peak-only beam grid, shared among the channels' passes in chromatic media (0: straight beams; "auto": 2^15, and 2^15 sqrt(pixels / 128^2), at most 8 x 2^15, for a light whose forward peak the camera looks into: auto_beam_photons in mfs_settings.cpp) |
 // | `beam_spread`             | "straight" or "traced"        | "straight" | the peak-only light's angular spread: the straight beam's peak depth ln(T_wide / T_light) (D8), or the beam grid's photons' mean cosine read against the straight beam's (D9b; backlit spheres' binned error 1.4x, docs/benchmarks.md "The beam's spread") |
@@ -113,6 +114,7 @@ struct MfsSettings {
   bool source_blur = false;
   bool camera_tilt = true;
   bool camera_shift = false;
+  bool grid_denoise = true;
   bool peak_toward_camera = false;
   std::optional<bool> exact_light_transmittance;  // nullopt: "auto" (resolved by MfsIntegrator)
   int shadow_map_resolution = 64;

@@ -263,7 +263,7 @@ FloatArray trace_photons(size_t total, uint64_t stream_seed, size_t tally_size, 
 
 FloatArray trace_photons_folded(size_t total, uint64_t stream_seed, size_t tally_size, double scale,
                                 const TallyFold& fold, const TracePhoton& trace_photon,
-                                uint64_t* rejection_failures) {
+                                uint64_t* rejection_failures, FloatArray* per_batch) {
   // (Named, not a structured binding: clang 14 cannot capture one in the lambdas below.)
   const TracedBatches traced = run_batches(total, stream_seed, tally_size, trace_photon, rejection_failures);
   const std::vector<PhotonBatch>& batch = traced.batch;
@@ -271,12 +271,19 @@ FloatArray trace_photons_folded(size_t total, uint64_t stream_seed, size_t tally
   // Fold the batches node by node, in order (the same sum for every thread count).
   const int k = fold.out_floats;
   FloatArray sum(fold.nodes * size_t(k));
+  const size_t probes = per_batch ? fold.probes.size() : 0;
+  if (per_batch) *per_batch = FloatArray(fold.nodes * kPhotonBatches * probes);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, fold.nodes), [&](const tbb::blocked_range<size_t>& r) {
-    std::vector<double> acc(static_cast<size_t>(k));
+    std::vector<double> acc(static_cast<size_t>(k)), before(probes);
     for (size_t n = r.begin(); n != r.end(); ++n) {
       std::fill(acc.begin(), acc.end(), 0.0);
-      for (int b = 0; b < kPhotonBatches; ++b)
+      for (int b = 0; b < kPhotonBatches; ++b) {
+        for (size_t p = 0; p < probes; ++p) before[p] = acc[size_t(fold.probes[p])];
         fold.fold(batch[b].tally.data(), n, batch_scale[b], acc.data());
+        float* share = probes ? &(*per_batch)[(n * kPhotonBatches + size_t(b)) * probes] : nullptr;
+        for (size_t p = 0; p < probes; ++p)
+          share[p] = float((acc[size_t(fold.probes[p])] - before[p]) * scale);
+      }
       for (int i = 0; i < k; ++i) sum[n * k + i] = float(acc[i] * scale);
     }
   });

@@ -114,11 +114,15 @@ struct TallyFold {
   size_t nodes = 0;
   int out_floats = 0;
   std::function<void(const float* tally, size_t node, double weight, double* acc)> fold;
+  // Result floats (indices < out_floats) whose share from each batch is also kept (per_batch below).
+  std::vector<int> probes;
 };
 // trace_photons with the batches' tallies folded (in order, in double) into nodes x out_floats values.
+// per_batch (if not null): per node, per batch, per probe, that batch's share of the probe's value (times
+// `scale`, as the result): the batches are independent, so their spread is the result's noise.
 FloatArray trace_photons_folded(size_t total, uint64_t stream_seed, size_t tally_size, double scale,
                                 const TallyFold& fold, const TracePhoton& trace_photon,
-                                uint64_t* rejection_failures);
+                                uint64_t* rejection_failures, FloatArray* per_batch = nullptr);
 
 // The share of the majorant that bounds an extinction which keeps, of each medium i, its absorption
 // and kept(i) (in [0, 1]) of its scattering (the colour grid's tint, at most 1, only lowers it):

@@ -12,6 +12,8 @@
 
 #include "core/check.h"
 #include "core/sh.h"
+#include "integrators/beam_grid.h"
+#include "integrators/grid_denoise.h"
 #include "integrators/photon_tracer.h"
 #include "integrators/shadow_map.h"
 #include "media/emission_sampler.h"
@@ -678,6 +680,22 @@ bool exact_pieces(const SceneContext& ctx, const ScatterGridSettings& s) {
   return max_component(m.sigma_s) > 0.0 && sigma_t.x == sigma_t.y && sigma_t.y == sigma_t.z;
 }
 
+// The photons' batches summed and divided by the node volume (fluence and flux); with s.denoise, denoised
+// (grid_denoise.h) by the batches' shares of each channel's l = 0 coefficient.
+FloatArray sum_batches(const SceneContext& ctx, const ScatterGridSettings& s, const NodeGrid& grid,
+                       TallyFold fold, int channels, int coeffs, size_t total, size_t tally_size,
+                       const TracePhoton& trace, uint64_t* rejection_failures) {
+  for (int ch = 0; s.denoise && ch < channels; ++ch) fold.probes.push_back(ch * coeffs);
+  FloatArray per_batch;
+  FloatArray values =
+      trace_photons_folded(total, s.seed ^ 0x6d756c7469706c65ull, tally_size, 1.0 / grid.cell_volume(), fold,
+                           trace, rejection_failures, s.denoise ? &per_batch : nullptr);
+  if (s.denoise)
+    denoise_grid(&values, grid, channels * coeffs, per_batch, kPhotonBatches, fold.probes,
+                 nodes_inside(grid, ctx.media));
+  return values;
+}
+
 }  // namespace
 
 ScatterGrid::ScatterGrid(const SceneContext& ctx, const std::vector<const PhaseSplit*>& splits,
@@ -751,10 +769,9 @@ void ScatterGrid::trace(const SceneContext& ctx, const std::vector<const PhaseSp
   const std::optional<Rgb> tint = common_colour(photons.blocks, rgb_size);
   channels_ = tint ? 1 : 3;
   tint_ = tint.value_or(Rgb(1.0));
-  const TallyFold fold = tally_fold(photons.blocks, rgb_size, coeffs_, grid_.size(), channels_);
-  // The batches' sums divided by the node volume: fluence and flux.
-  values_ = trace_photons_folded(
-      total, s.seed ^ 0x6d756c7469706c65ull, tally_size, 1.0 / grid_.cell_volume(), fold,
+  values_ = sum_batches(
+      ctx, s, grid_, tally_fold(photons.blocks, rgb_size, coeffs_, grid_.size(), channels_), channels_,
+      coeffs_, total, tally_size,
       [&](size_t j, Rng& rng, PhotonBatch& batch) { photons.trace(j, rng, batch); }, &rejection_failures_);
   if (s.prefiltered) build_mips();
 }

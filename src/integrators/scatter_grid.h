@@ -96,6 +96,9 @@ struct ScatterGridSettings {
   bool deposit_midpoints = false;
   uint64_t seed = 1;
   const MajorantGrid* majorants = nullptr;  // the photons' tracking majorants (null: the scene's)
+  // Filter the nodes inside the media where their difference from their neighbours is noise, by the
+  // photon batches' spread (integrators/grid_denoise.h; `mfs`'s grid_denoise).
+  bool denoise = false;
 };
 
 class ScatterGrid {

@@ -101,7 +101,8 @@ TEST(Registry, DefaultsAreWrittenOut) {
   EXPECT_EQ(mfs["beam_spread"], "straight");
   EXPECT_EQ(mfs["beam_photons"], "auto");
   EXPECT_EQ(mfs["beam_smoothing"], 2);
-  EXPECT_EQ(mfs.size(), 26u);  // every option of the table in mfs.h
+  EXPECT_EQ(mfs["grid_denoise"], true);
+  EXPECT_EQ(mfs.size(), 27u);  // every option of the table in mfs.h
 }
 
 TEST(Registry, UnknownFieldsAndNamesAreErrors) {
