@@ -1,9 +1,9 @@
 // The scatter grid's denoising (integrators/grid_denoise.h).
 #include "integrators/grid_denoise.h"
 
-#include <algorithm>
+#include <tbb/parallel_for.h>
 
-#include "integrators/beam_grid.h"
+#include <algorithm>
 
 namespace nimbus {
 
@@ -12,7 +12,7 @@ namespace {
 // The mean of a over each node's 3 x 3 x 3 neighbourhood (those within the grid).
 std::vector<double> box_mean(const std::vector<double>& a, const NodeGrid& g) {
   std::vector<double> out(a.size(), 0.0);
-  for (int z = 0; z < g.nodes[2]; ++z)
+  tbb::parallel_for(0, g.nodes[2], [&](int z) {
     for (int y = 0; y < g.nodes[1]; ++y)
       for (int x = 0; x < g.nodes[0]; ++x) {
         double sum = 0.0;
@@ -23,7 +23,40 @@ std::vector<double> box_mean(const std::vector<double>& a, const NodeGrid& g) {
               sum += a[g.index(i, j, k)];
         out[g.index(x, y, z)] = sum / count;
       }
+  });
   return out;
+}
+
+// One pass along axis a of the filter (-3, 12, 17, 12, -3) / 35 from `before` into v, at the nodes whose
+// four neighbours along the axis are inside too (the others keep their values). `stride` floats per node.
+void filter_axis(FloatArray* v, const FloatArray& before, const NodeGrid& g,
+                 const std::vector<uint8_t>& inside, size_t stride, int a) {
+  const size_t ns = a == 0 ? 1 : a == 1 ? size_t(g.nodes[0]) : size_t(g.nodes[0]) * g.nodes[1];
+  const size_t step = ns * stride;
+  tbb::parallel_for(0, g.nodes[2], [&](int z) {
+    for (int y = 0; y < g.nodes[1]; ++y)
+      for (int x = 0; x < g.nodes[0]; ++x) {
+        const size_t n = g.index(x, y, z);
+        const int q = a == 0 ? x : a == 1 ? y : z;
+        if (!inside[n] || q < 2 || q + 2 >= g.nodes[a] || !inside[n - ns] || !inside[n + ns] ||
+            !inside[n - 2 * ns] || !inside[n + 2 * ns])
+          continue;
+        for (size_t i = n * stride; i < (n + 1) * stride; ++i)
+          (*v)[i] = (-3.0f * (before[i - 2 * step] + before[i + 2 * step]) +
+                     12.0f * (before[i - step] + before[i + step]) + 17.0f * before[i]) *
+                    (1.0f / 35.0f);
+      }
+  });
+}
+
+// kDenoisePasses of filter_axis along each axis in turn.
+void smooth_quadratic(FloatArray* v, const NodeGrid& g, const std::vector<uint8_t>& inside, size_t stride) {
+  FloatArray before(v->size());
+  for (int pass = 0; pass < kDenoisePasses; ++pass)
+    for (int a = 0; a < 3; ++a) {
+      std::copy(v->begin(), v->end(), before.begin());
+      filter_axis(v, before, g, inside, stride, a);
+    }
 }
 
 }  // namespace
@@ -34,8 +67,8 @@ void denoise_grid(FloatArray* values, const NodeGrid& grid, int floats, const Fl
   if (nodes == 0 || P == 0 || batches < 2 || per_batch.size() != nodes * B * P || inside.size() != nodes)
     return;
   FloatArray smooth = *values, smooth_batch = per_batch;
-  smooth_nodes_inside(&smooth, grid, inside, floats, kDenoisePasses);
-  smooth_nodes_inside(&smooth_batch, grid, inside, int(B * P), kDenoisePasses);
+  smooth_quadratic(&smooth, grid, inside, size_t(floats));
+  smooth_quadratic(&smooth_batch, grid, inside, B * P);
   // Per node: d^2 and the variance of d over the probes together.
   std::vector<double> d2(nodes, 0.0), var(nodes, 0.0);
   for (size_t n = 0; n < nodes; ++n)
