@@ -141,14 +141,16 @@ double pixel_scale(const PinholeCamera& camera) {
 // "auto" scatter-grid (and beam-grid) resolution: from 512 x 512 pixels on, cells of at most ~1.6 optical
 // depths at the medium's typical extinction (the mean of the majorant grid's non-empty cells), 32 to 64
 // nodes along the longest axis (32 up to an optical size of ~50 across); smaller images take that times
-// 7/8 up to 128 x 128 pixels, 1/32 more per doubling of the width between (the full image's pixels, as
-// auto_photons): 28 nodes for the small media at 128 x 128. A grid of spacing h blurs the photons' light
+// 3/4 up to 128 x 128 pixels, 1/8 more per doubling of the width between (the full image's pixels, as
+// auto_photons): 24 nodes for the small media at 128 x 128. A grid of spacing h blurs the photons' light
 // by its deposit and lookup tents, a bias ~h^2 (the side-lit r = 10 sphere's mean with 2^22 photons:
 // -2.2, -1.5, -1.0, -0.6 % at 24, 32, 48 and 96 nodes), and its noise variance goes as
 // 1 / (photons h^3): the larger images' photons (auto_photons) buy a finer grid. Measured
 // (docs/benchmarks.md, "The grids' resolution by image size"): at 128 x 128, 28 against 32 nodes gives
 // 0.87x error^2 x CPU over the suite's spheres and box (10 seeds), 48 against 55 0.84x on the Disney
-// cloud (6 seeds); at 512 x 512, 28 and 32 are the same and 40 is worse.
+// cloud (6 seeds); at 512 x 512, 28 and 32 are the same and 40 is worse. With the scatter grid denoised
+// (grid_denoise), 3/4 against 7/8 at 128 x 128 gives 0.79-0.95x error^2 x CPU on all nine suite scenes
+// (6 seeds; docs/benchmarks.md, "The scatter grid denoised").
 int auto_scatter_grid_resolution(const SceneContext& ctx) {
   const Bounds b = ctx.media.bounds();
   double sum = 0.0;
@@ -161,7 +163,7 @@ int auto_scatter_grid_resolution(const SceneContext& ctx) {
   const Vec3 e = b.empty() ? Vec3(0.0) : b.hi - b.lo;
   const double across = cells > 0 ? std::max({e.x, e.y, e.z}) * sum / double(cells) : 0.0;
   const double nodes = std::isfinite(across) ? std::clamp(std::ceil(across / 1.6), 32.0, 64.0) : 64.0;
-  const double scale = std::min(1.0, (28.0 + 2.0 * std::log2(pixel_scale(ctx.camera))) / 32.0);
+  const double scale = std::min(1.0, (24.0 + 4.0 * std::log2(pixel_scale(ctx.camera))) / 32.0);
   return int(std::round(nodes * scale));
 }
 

@@ -37,7 +37,7 @@ TEST(RenderSettings, AutoChoicesAreResolvedInTheHeader) {
       settings_sphere_scene(R"({"type": "mfs", "spp": 1, "photons": 4096, "beam_photons": 1024})");
   const RenderResult r = render(scene);
   ASSERT_TRUE(r.settings["scatter_grid_resolution"].is_number_integer());
-  EXPECT_GE(r.settings["scatter_grid_resolution"].get<int>(), 28);
+  EXPECT_GE(r.settings["scatter_grid_resolution"].get<int>(), 24);
   EXPECT_LE(r.settings["scatter_grid_resolution"].get<int>(), 64);
   EXPECT_EQ(r.settings["type"], "mfs");
   EXPECT_EQ(r.settings["photons"], 4096);
@@ -63,8 +63,8 @@ TEST(RenderSettings, AutoGridResolutionFollowsTheImageAndTheOpticalSize) {
   // Extinction 3.1, 30.1 and 60.1 over a diameter of 2: 32, 38 (60.2 / 1.6) and 64 (75.1, clamped) nodes
   // from 512 x 512 on.
   for (const Case c :
-       {Case{8, 6, 28, 33, 56}, Case{128, 128, 28, 33, 56}, Case{181, 181, 29, 34, 58},
-        Case{256, 256, 30, 36, 60}, Case{512, 512, 32, 38, 64}, Case{1920, 1080, 32, 38, 64}}) {
+       {Case{8, 6, 24, 29, 48}, Case{128, 128, 24, 29, 48}, Case{181, 181, 26, 31, 52},
+        Case{256, 256, 28, 33, 56}, Case{512, 512, 32, 38, 64}, Case{1920, 1080, 32, 38, 64}}) {
     const auto nodes = [&](double sigma_s) {
       return auto_scatter_grid_resolution(
           SceneContext(settings_sphere_scene(mfs, c.width, c.height, sigma_s)));
