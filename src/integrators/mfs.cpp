@@ -33,6 +33,7 @@ MfsIntegrator::MfsIntegrator(const SceneContext& context, MfsSettings settings, 
     if (sp->f() > 0.0) cut_angle = std::max(cut_angle, sp->cut_angle());
   beam_counts_ = s_.beam_photons ? std::vector<int>(ctx_.lights.size(), *s_.beam_photons)
                                  : auto_beam_photons(ctx_, cut_angle);
+  if (!s_.edge_samples) s_.edge_samples = auto_edge_samples(ctx_, cut_angle);
   if (!beam_counts_.empty() &&
       std::all_of(beam_counts_.begin(), beam_counts_.end(), [&](int n) { return n == beam_counts_[0]; }))
     s_.beam_photons = beam_counts_[0];  // the header's settings: one count for every light, or "auto"

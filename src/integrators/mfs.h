@@ -58,7 +58,7 @@
 // | `peak_toward_camera`      | boolean                       | false     | the forward peak alone takes its angular factor from the beam grid's photons (their P_peak towards the camera) instead of peak_eff at the beam's mean-cosine depth (one medium only) |
 // | `exact_light_transmittance` | "auto" or boolean           | "auto"    | T_light and T_wide to directional and point lights without the shadow maps: the chord in closed form for one constant-density sphere or box, else a march ("auto": true for one constant-density sphere or box, else false; the header of a rendered image holds the choice) |
 // | `shadow_map_resolution`   | integer in [8, 1024]          | 64        | deep shadow map nodes along the longest axis |
-// | `edge_samples`            | integer in [1, 64]            | 16        | samples per pixel sample at pixels a hard outline crosses (constant-density spheres and boxes, surfaces: scene/edges.h), a quarter of it (at least 1) beside them; 1: none (docs/benchmarks.md "Samples at the outlines") |
+// | `edge_samples`            | "auto" or integer in [1, 64]  | "auto"    | samples per pixel sample at pixels a hard outline crosses (constant-density spheres and boxes, surfaces: scene/edges.h), a quarter of it (at least 1) beside them; 1: none; "auto": 64 where the camera looks into a directional or point light's forward peak (auto_edge_samples), else 16 (docs/benchmarks.md "Samples at the outlines") |
 //
 // forward_side "light" needs light_path "forward" and photon_transport "exact": the other values are
 // errors naming both fields.
@@ -118,7 +118,7 @@ struct MfsSettings {
   bool peak_toward_camera = false;
   std::optional<bool> exact_light_transmittance;  // nullopt: "auto" (resolved by MfsIntegrator)
   int shadow_map_resolution = 64;
-  int edge_samples = 16;
+  std::optional<int> edge_samples;  // nullopt: "auto" (resolved by MfsIntegrator: auto_edge_samples)
 
   bool forward_light_path() const { return light_path == LightPath::forward; }
   bool light_side() const { return forward_side == ForwardSide::light; }
@@ -142,7 +142,7 @@ class MfsIntegrator final : public Integrator {
   Rgb trace(const Ray& ray, Rng& rng, CameraSample* sample, int bounces) const;
   // The settings with "auto" resolved (scatter_grid_resolution).
   nlohmann::json settings_json() const override { return to_json(s_); }
-  int edge_samples() const override { return s_.edge_samples; }
+  int edge_samples() const override { return s_.edge_samples.value_or(16); }
   const PhaseSplit& split(int medium) const { return *splits_[medium]; }
   const ScatterGrid* scatter_grid() const { return grid_.get(); }
   const BeamGrid* beam_grid() const { return beam_.get(); }

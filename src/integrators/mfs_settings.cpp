@@ -53,7 +53,8 @@ MfsSettings mfs_settings_from_json(const nlohmann::json& options, const std::str
   if (bool b = false; o.keyword_or_boolean("exact_light_transmittance", "auto", &b))
     s.exact_light_transmittance = b;
   s.shadow_map_resolution = int(o.integer("shadow_map_resolution", 8, 1024, s.shadow_map_resolution));
-  s.edge_samples = int(o.integer("edge_samples", 1, kMaxEdgeSamples, s.edge_samples));
+  if (int64_t n = 0; o.keyword_or_integer("edge_samples", "auto", 1, kMaxEdgeSamples, &n))
+    s.edge_samples = int(n);
   o.finish();
   // The light side carries the light to every scatter through peak scatters, with photons in the true
   // medium: other choices would be silently overridden, so they are errors.
@@ -67,27 +68,29 @@ MfsSettings mfs_settings_from_json(const nlohmann::json& options, const std::str
 }
 
 nlohmann::json to_json(const MfsSettings& s) {
-  nlohmann::json j = {{"tau_step", s.tau_step},
-                      {"step_growth", s.step_growth},
-                      {"light_path", kLightPathNames[int(s.light_path)]},
-                      {"propagator", kPropagatorNames[int(s.propagator)]},
-                      {"photon_transport", kPhotonTransportNames[int(s.photon_transport)]},
-                      {"channel_passes", s.channel_passes},
-                      {"scatter_grid_bands", s.scatter_grid_bands},
-                      {"forward_side", kForwardSideNames[int(s.forward_side)]},
-                      {"beam_spread", kBeamSpreadNames[int(s.beam_spread)]},
-                      {"beam_smoothing", s.beam_smoothing},
-                      {"photon_splat", kSplatNames[int(s.photon_splat)]},
-                      {"light_blur", s.light_blur},
-                      {"path_lengthening", s.path_lengthening},
-                      {"filtered_lookups", s.filtered_lookups},
-                      {"source_blur", s.source_blur},
-                      {"camera_tilt", s.camera_tilt},
-                      {"camera_shift", s.camera_shift},
-                      {"grid_denoise", s.grid_denoise},
-                      {"peak_toward_camera", s.peak_toward_camera},
-                      {"shadow_map_resolution", s.shadow_map_resolution},
-                      {"edge_samples", s.edge_samples}};
+  nlohmann::json j = {
+      {"tau_step", s.tau_step},
+      {"step_growth", s.step_growth},
+      {"light_path", kLightPathNames[int(s.light_path)]},
+      {"propagator", kPropagatorNames[int(s.propagator)]},
+      {"photon_transport", kPhotonTransportNames[int(s.photon_transport)]},
+      {"channel_passes", s.channel_passes},
+      {"scatter_grid_bands", s.scatter_grid_bands},
+      {"forward_side", kForwardSideNames[int(s.forward_side)]},
+      {"beam_spread", kBeamSpreadNames[int(s.beam_spread)]},
+      {"beam_smoothing", s.beam_smoothing},
+      {"photon_splat", kSplatNames[int(s.photon_splat)]},
+      {"light_blur", s.light_blur},
+      {"path_lengthening", s.path_lengthening},
+      {"filtered_lookups", s.filtered_lookups},
+      {"source_blur", s.source_blur},
+      {"camera_tilt", s.camera_tilt},
+      {"camera_shift", s.camera_shift},
+      {"grid_denoise", s.grid_denoise},
+      {"peak_toward_camera", s.peak_toward_camera},
+      {"shadow_map_resolution", s.shadow_map_resolution},
+  };
+  j["edge_samples"] = s.edge_samples ? nlohmann::json(*s.edge_samples) : nlohmann::json("auto");
   j["peak_fraction"] = s.peak_fraction ? nlohmann::json(*s.peak_fraction) : nlohmann::json("auto");
   j["large_angle_scatters"] =
       s.large_angle_scatters ? nlohmann::json(*s.large_angle_scatters) : nlohmann::json("all");
@@ -232,6 +235,17 @@ std::vector<int> auto_beam_photons(const SceneContext& ctx, double cut_angle) {
     n.push_back(camera_in_forward_peak(ctx, light, cut_angle) ? int(std::round(kAutoBeamPhotons * scale))
                                                               : kAutoBeamPhotons);
   return n;
+}
+
+// "auto" edge samples: 64 where the camera looks into a directional or point light's forward peak
+// (camera_in_forward_peak), else 16. Looking into the peak, the outline of a dense medium is its brightest
+// part (the silver lining), and the pixels it crosses are most of the backlit spheres' error once the photon
+// grids are denoised; elsewhere the outline is no brighter than the inside and more samples there buy nothing
+// (docs/benchmarks.md, "Samples at the outlines"). The full image's camera, as auto_beam_photons.
+int auto_edge_samples(const SceneContext& ctx, double cut_angle) {
+  for (const Light& light : ctx.lights)
+    if (camera_in_forward_peak(ctx, light, cut_angle)) return 64;
+  return 16;
 }
 
 // The scatter grid's settings from mfs's (photons resolved; adaptive: they were "auto").

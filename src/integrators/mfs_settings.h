@@ -19,6 +19,8 @@ int auto_scatter_grid_resolution(const SceneContext& ctx);
 int auto_photons(const PinholeCamera& camera);
 // "auto" beam-grid photons per light, given the widest peak's cut angle [rad].
 std::vector<int> auto_beam_photons(const SceneContext& ctx, double cut_angle);
+// "auto" edge samples (MfsSettings::edge_samples), given the widest peak's cut angle [rad].
+int auto_edge_samples(const SceneContext& ctx, double cut_angle);
 // The scatter grid's settings from mfs's (photons resolved; adaptive: they were "auto").
 ScatterGridSettings scatter_grid_settings(const MfsSettings& s, bool adaptive, uint64_t seed,
                                           const MajorantGrid* tracking);

@@ -55,6 +55,26 @@ TEST(RenderSettings, AutoChoicesAreResolvedInTheHeader) {
 
 // The "auto" grid resolution: cells of ~1.6 optical depths, 32 to 64 nodes, from 512 x 512 pixels on;
 // 7/8 of that up to 128 x 128, 1/32 more per doubling of the width between.
+// "auto" edge samples: 64 where the camera looks into a light's forward peak (a backlit medium's silver
+// lining), 16 elsewhere; a number given stays.
+TEST(RenderSettings, AutoEdgeSamplesFollowTheLightsForwardPeak) {
+  const auto edge = [](const std::string& direction, const std::string& extra) {
+    const Scene scene = test::scene_from_json("{" + test::camera_json(8, 6) + R"(,
+      "media": [{"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1}, "sigma_s": 3, "sigma_a": 0.1,
+                 "phase": {"type": "hg", "g": 0.8}}],
+      "lights": [{"type": "directional", "direction": )" +
+                                              direction +
+                                              R"(, "irradiance": 1.0}],
+      "integrator": {"type": "mfs", "spp": 1, "photons": 4096, "beam_photons": 1024)" +
+                                              extra + "}}");
+    return render(scene).settings["edge_samples"];
+  };
+  EXPECT_EQ(edge("[0, -1, 0]", ""), 64);      // backlit: the camera looks into the peak
+  EXPECT_EQ(edge("[-1, 0.3, 0.2]", ""), 16);  // side-lit
+  EXPECT_EQ(edge("[0, 1, 0]", ""), 16);       // front-lit
+  EXPECT_EQ(edge("[0, -1, 0]", R"(, "edge_samples": 4)"), 4);
+}
+
 TEST(RenderSettings, AutoGridResolutionFollowsTheImageAndTheOpticalSize) {
   const std::string mfs = R"({"type": "mfs", "spp": 1})";
   struct Case {
