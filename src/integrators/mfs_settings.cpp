@@ -237,14 +237,17 @@ std::vector<int> auto_beam_photons(const SceneContext& ctx, double cut_angle) {
   return n;
 }
 
-// "auto" edge samples: 64 where the camera looks into a directional or point light's forward peak
-// (camera_in_forward_peak), else 16. Looking into the peak, the outline of a dense medium is its brightest
-// part (the silver lining), and the pixels it crosses are most of the backlit spheres' error once the photon
-// grids are denoised; elsewhere the outline is no brighter than the inside and more samples there buy nothing
-// (docs/benchmarks.md, "Samples at the outlines"). The full image's camera, as auto_beam_photons.
+// "auto" edge samples: 16, and where the camera looks into a directional or point light's forward peak
+// (camera_in_forward_peak) 64 up to 128 x 128 pixels, 64 / sqrt(pixels / 128^2) above (16 from 512 x 512 on).
+// Looking into the peak, the outline of a dense medium is its brightest part (the silver lining); at small
+// sizes a pixel holds much of that thin rim, and its outline pixels are most of the backlit spheres' error once
+// the photon grids are denoised (at 512 x 512 far less). Elsewhere the outline is no brighter than the inside
+// and more samples there buy nothing (docs/benchmarks.md, "Samples at the outlines"). The full image's
+// camera, as auto_beam_photons.
 int auto_edge_samples(const SceneContext& ctx, double cut_angle) {
   for (const Light& light : ctx.lights)
-    if (camera_in_forward_peak(ctx, light, cut_angle)) return 64;
+    if (camera_in_forward_peak(ctx, light, cut_angle))
+      return int(std::clamp(std::round(64.0 / pixel_scale(ctx.camera)), 16.0, 64.0));
   return 16;
 }
 

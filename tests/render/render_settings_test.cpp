@@ -10,6 +10,7 @@
 #include "nimbus/render.h"
 #include "scene/context.h"
 #include "support/scenes.h"
+#include "transport/phase_split.h"
 
 namespace nimbus {
 namespace {
@@ -55,24 +56,34 @@ TEST(RenderSettings, AutoChoicesAreResolvedInTheHeader) {
 
 // The "auto" grid resolution: cells of ~1.6 optical depths, 32 to 64 nodes, from 512 x 512 pixels on;
 // 7/8 of that up to 128 x 128, 1/32 more per doubling of the width between.
-// "auto" edge samples: 64 where the camera looks into a light's forward peak (a backlit medium's silver
-// lining), 16 elsewhere; a number given stays.
+// "auto" edge samples: where the camera looks into a light's forward peak (a backlit medium's silver lining)
+// 64 up to 128 x 128 pixels, 64 / sqrt(pixels / 128^2) above, at least 16; 16 elsewhere; a number given stays.
 TEST(RenderSettings, AutoEdgeSamplesFollowTheLightsForwardPeak) {
-  const auto edge = [](const std::string& direction, const std::string& extra) {
-    const Scene scene = test::scene_from_json("{" + test::camera_json(8, 6) + R"(,
+  const auto scene_json = [](const std::string& direction, const std::string& extra, int w, int h) {
+    return "{" + test::camera_json(w, h) + R"(,
       "media": [{"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1}, "sigma_s": 3, "sigma_a": 0.1,
                  "phase": {"type": "hg", "g": 0.8}}],
       "lights": [{"type": "directional", "direction": )" +
-                                              direction +
-                                              R"(, "irradiance": 1.0}],
+           direction +
+           R"(, "irradiance": 1.0}],
       "integrator": {"type": "mfs", "spp": 1, "photons": 4096, "beam_photons": 1024)" +
-                                              extra + "}}");
-    return render(scene).settings["edge_samples"];
+           extra + "}}";
+  };
+  const auto edge = [&](const std::string& direction, const std::string& extra) {
+    return render(test::scene_from_json(scene_json(direction, extra, 8, 6))).settings["edge_samples"];
   };
   EXPECT_EQ(edge("[0, -1, 0]", ""), 64);      // backlit: the camera looks into the peak
   EXPECT_EQ(edge("[-1, 0.3, 0.2]", ""), 16);  // side-lit
   EXPECT_EQ(edge("[0, 1, 0]", ""), 16);       // front-lit
   EXPECT_EQ(edge("[0, -1, 0]", R"(, "edge_samples": 4)"), 4);
+  const auto at_size = [&](int w, int h) {  // the peak's cut angle of HG 0.8 at its "auto" peak fraction
+    const SceneContext ctx(test::scene_from_json(scene_json("[0, -1, 0]", "", w, h)));
+    return auto_edge_samples(ctx, PhaseSplit(HgPhase{0.8}, 0.64).cut_angle());
+  };
+  EXPECT_EQ(at_size(128, 128), 64);
+  EXPECT_EQ(at_size(256, 256), 32);
+  EXPECT_EQ(at_size(512, 512), 16);
+  EXPECT_EQ(at_size(1920, 1080), 16);
 }
 
 TEST(RenderSettings, AutoGridResolutionFollowsTheImageAndTheOpticalSize) {
