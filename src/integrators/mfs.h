@@ -58,7 +58,7 @@
 // | `peak_toward_camera`      | boolean                       | false     | the forward peak alone takes its angular factor from the beam grid's photons (their P_peak towards the camera) instead of peak_eff at the beam's mean-cosine depth (one medium only) |
 // | `exact_light_transmittance` | "auto" or boolean           | "auto"    | T_light and T_wide to directional and point lights without the shadow maps: the chord in closed form for one constant-density sphere or box, else a march ("auto": true for one constant-density sphere or box, else false; the header of a rendered image holds the choice) |
 // | `shadow_map_resolution`   | integer in [8, 1024]          | 64        | deep shadow map nodes along the longest axis |
-// | `edge_samples`            | "auto" or integer in [1, 64]  | "auto"    | samples per pixel sample at pixels a hard outline crosses (constant-density spheres and boxes, surfaces: scene/edges.h), a quarter of it (at least 1) beside them; 1: none; "auto": 64 where the camera looks into a directional or point light's forward peak (auto_edge_samples), else 16 (docs/benchmarks.md "Samples at the outlines") |
+// | `edge_samples`            | "auto" or integer in [1, 64]  | "auto"    | samples per pixel sample at pixels a hard outline crosses (constant-density spheres and boxes, surfaces: scene/edges.h), a quarter of it (at least 1) beside them; 1: none; "auto": where the camera looks into a directional or point light's forward peak 64 up to 128 x 128 pixels, 64 / sqrt(pixels / 128^2) above, at least 16 (auto_edge_samples), else 16 (docs/benchmarks.md "Samples at the outlines") |
 //
 // forward_side "light" needs light_path "forward" and photon_transport "exact": the other values are
 // errors naming both fields.

@@ -68,28 +68,26 @@ MfsSettings mfs_settings_from_json(const nlohmann::json& options, const std::str
 }
 
 nlohmann::json to_json(const MfsSettings& s) {
-  nlohmann::json j = {
-      {"tau_step", s.tau_step},
-      {"step_growth", s.step_growth},
-      {"light_path", kLightPathNames[int(s.light_path)]},
-      {"propagator", kPropagatorNames[int(s.propagator)]},
-      {"photon_transport", kPhotonTransportNames[int(s.photon_transport)]},
-      {"channel_passes", s.channel_passes},
-      {"scatter_grid_bands", s.scatter_grid_bands},
-      {"forward_side", kForwardSideNames[int(s.forward_side)]},
-      {"beam_spread", kBeamSpreadNames[int(s.beam_spread)]},
-      {"beam_smoothing", s.beam_smoothing},
-      {"photon_splat", kSplatNames[int(s.photon_splat)]},
-      {"light_blur", s.light_blur},
-      {"path_lengthening", s.path_lengthening},
-      {"filtered_lookups", s.filtered_lookups},
-      {"source_blur", s.source_blur},
-      {"camera_tilt", s.camera_tilt},
-      {"camera_shift", s.camera_shift},
-      {"grid_denoise", s.grid_denoise},
-      {"peak_toward_camera", s.peak_toward_camera},
-      {"shadow_map_resolution", s.shadow_map_resolution},
-  };
+  nlohmann::json j = {{"tau_step", s.tau_step},
+                      {"step_growth", s.step_growth},
+                      {"light_path", kLightPathNames[int(s.light_path)]},
+                      {"propagator", kPropagatorNames[int(s.propagator)]},
+                      {"photon_transport", kPhotonTransportNames[int(s.photon_transport)]},
+                      {"channel_passes", s.channel_passes},
+                      {"scatter_grid_bands", s.scatter_grid_bands},
+                      {"forward_side", kForwardSideNames[int(s.forward_side)]},
+                      {"beam_spread", kBeamSpreadNames[int(s.beam_spread)]},
+                      {"beam_smoothing", s.beam_smoothing},
+                      {"photon_splat", kSplatNames[int(s.photon_splat)]},
+                      {"light_blur", s.light_blur},
+                      {"path_lengthening", s.path_lengthening},
+                      {"filtered_lookups", s.filtered_lookups},
+                      {"source_blur", s.source_blur},
+                      {"camera_tilt", s.camera_tilt},
+                      {"camera_shift", s.camera_shift},
+                      {"grid_denoise", s.grid_denoise},
+                      {"peak_toward_camera", s.peak_toward_camera},
+                      {"shadow_map_resolution", s.shadow_map_resolution}};
   j["edge_samples"] = s.edge_samples ? nlohmann::json(*s.edge_samples) : nlohmann::json("auto");
   j["peak_fraction"] = s.peak_fraction ? nlohmann::json(*s.peak_fraction) : nlohmann::json("auto");
   j["large_angle_scatters"] =
