@@ -203,14 +203,14 @@ MfsIntegrator::Sources MfsIntegrator::step_sources(const MediumPoint& m, const V
                                                    const CameraPath& cam, Rng& rng,
                                                    FootprintProbe* probe) const {
   Sources src;
-  double residual = 1.0;
+  double residual = 1.0, kept = 1.0;
   bool bulk = false;
   if (s_.light_side()) {  // forward_side "light" has no camera-side spread
     add_sources(m, p, d, d, y_out, t, y, cam, rng, true, true, &src);
   } else if (s_.source_blur) {
     add_sources(m, p, d, d, y_out, t, y, cam, rng, false, true, &src);
     add_blurred_sources(p, d, y_out, t, y, cam, rng, &src);
-  } else if (Vec3 d_s; probe && tilt(p, d, t, cam, *probe, &d_s, &residual, &bulk)) {
+  } else if (Vec3 d_s; probe && tilt(p, d, t, cam, *probe, &d_s, &residual, &bulk, &kept)) {
     if (bulk) {  // eq. D17: the lights' first wide scatter tilted along their beams' gradients
       CameraPoint y_g = y;
       y_g.gradient_tilt = cam.offset_deflection_covariance(t) * y.sigma_red;
@@ -224,6 +224,10 @@ MfsIntegrator::Sources MfsIntegrator::step_sources(const MediumPoint& m, const V
   } else {
     add_sources(m, p, d, d, y_out, t, y, cam, rng, true, true, &src);
   }
+  if (kept < 1.0) {  // eq. D18: the scattered light of the footprint's half that left by the entry face
+    src.in_scatter *= kept;
+    src.lights_scatter *= kept;
+  }
   return src;
 }
 
@@ -234,11 +238,16 @@ std::optional<FootprintProbe> MfsIntegrator::footprint_probe(const Vec3& d, Rng&
 }
 
 bool MfsIntegrator::tilt(const Vec3& p, const Vec3& d, double t, const CameraPath& cam, FootprintProbe& probe,
-                         Vec3* d_s, double* residual, bool* bulk) const {
+                         Vec3* d_s, double* residual, bool* bulk, double* kept) const {
   const double sigma = cam.lateral_spread(t);
   if (!(sigma > 0.0)) return false;
   const Vec3 u = probe.next(sigma);
   const bool plus = ctx_.media.inside(p + u), minus = ctx_.media.inside(p - u);
+  if (s_.entry_loss && !(plus && minus)) {  // eq. D18
+    const double r = u.length();
+    *kept = 0.5 * ((plus || !before_entry(p + u, d, r) ? 1.0 : 0.0) +
+                   (minus || !before_entry(p - u, d, r) ? 1.0 : 0.0));
+  }
   if (plus && minus && s_.camera_shift) {  // eq. D17: the bulk
     *bulk = true;
     return true;
@@ -246,6 +255,15 @@ bool MfsIntegrator::tilt(const Vec3& p, const Vec3& d, double t, const CameraPat
   if (plus == minus) return false;
   *d_s = survivor_direction(cam, t, d, plus ? u : -u, residual);
   return true;
+}
+
+bool MfsIntegrator::before_entry(const Vec3& q, const Vec3& d, double r) const {
+  // Nearest first, ahead then behind: the first medium met decides.
+  for (const double k : {0.25, 0.5, 1.0, 2.0, 4.0}) {
+    if (ctx_.media.inside(q + d * (k * r))) return true;
+    if (ctx_.media.inside(q - d * (k * r))) return false;
+  }
+  return false;  // no medium along the line near q: it passed beside the media
 }
 
 void MfsIntegrator::add_blurred_sources(const Vec3& p, const Vec3& d, const ShBasis& y_out, double t,

@@ -20,7 +20,8 @@
 //    spread (D10).
 // Near a medium's side the scattered light's direction is tilted towards the medium, as the camera-side
 // peak-scattered paths that stay in it are (camera_tilt, D16); optionally, in the bulk, the lights' first
-// wide scatter is read in the direction tilted along the beam's gradient (camera_shift, D17).
+// wide scatter is read in the direction tilted along the beam's gradient (camera_shift, D17). Where the
+// footprint leaves through the face the ray entered by, its scattered light is lost (entry_loss, D18).
 // Camera-side light is attenuated by the reduced extinction (times the 1 / cosh path lengthening, D5,
 // with path_lengthening). forward_side "light" (D11) instead spreads everything on the light's side and
 // takes the camera leg exactly. Light transmittances come from deep shadow maps (deterministic); the
@@ -55,6 +56,7 @@
 // | `source_blur`             | boolean                       | false     | the source (sigma_s times every scattered term) read at a point drawn from the camera-side lateral footprint (D10), so rays near a boundary gather partly outside the medium |
 // | `camera_tilt`             | boolean                       | true      | near a medium's side, the camera-bound light's direction is tilted towards the medium, as the peak-scattered paths that stayed in it are (D16; ignored with source_blur, forward_side "light" and light_path "beer_lambert") |
 // | `camera_shift`            | boolean                       | false     | in the bulk (both footprint points in a medium), the lights' first wide scatter read in the direction tilted towards each light by cov(offset, deflection) sigma_red: the correlation of the footprint's offset with its deflection along the beam's gradient (D17; with camera_tilt only) |
+// | `entry_loss`              | boolean                       | true      | where a footprint offset of a march step (with camera_tilt) lies outside the media before the entry of the line through it along the ray (the camera-bound paths displaced there left through the face the ray came in by, and no light beyond the ray's chord makes up for them), the scattered light of that half of the footprint is lost (D18) |
 // | `peak_toward_camera`      | boolean                       | false     | the forward peak alone takes its angular factor from the beam grid's photons (their P_peak towards the camera) instead of peak_eff at the beam's mean-cosine depth (one medium only) |
 // | `exact_light_transmittance` | "auto" or boolean           | "auto"    | T_light and T_wide to directional and point lights without the shadow maps: the chord in closed form for one constant-density sphere or box, else a march ("auto": true for one constant-density sphere or box, else false; the header of a rendered image holds the choice) |
 // | `shadow_map_resolution`   | integer in [8, 1024]          | 64        | deep shadow map nodes along the longest axis |
@@ -114,6 +116,7 @@ struct MfsSettings {
   bool source_blur = false;
   bool camera_tilt = true;
   bool camera_shift = false;
+  bool entry_loss = true;
   bool grid_denoise = true;
   bool peak_toward_camera = false;
   std::optional<bool> exact_light_transmittance;  // nullopt: "auto" (resolved by MfsIntegrator)
@@ -199,9 +202,14 @@ class MfsIntegrator final : public Integrator {
   // camera_tilt (eq. D16): whether exactly one of p +- u (u the probe's next point of the lateral footprint
   // of depth t) is in a medium; then d_s, the tilted direction, and residual, the share of tau_p left to
   // the spread. With camera_shift (eq. D17), also where both are (the bulk): then *bulk is set (and d_s,
-  // residual are not).
+  // residual are not). With entry_loss (eq. D18), *kept gets the share of the scattered light whose
+  // footprint half did not leave through the face the ray entered by (1, 0.5 or 0; left as it is where
+  // both points are in a medium).
   bool tilt(const Vec3& p, const Vec3& d, double t, const CameraPath& cam, FootprintProbe& probe, Vec3* d_s,
-            double* residual, bool* bulk) const;
+            double* residual, bool* bulk, double* kept) const;
+  // eq. D18: whether the line through q (a point outside the media) along d meets a medium ahead of q
+  // before one behind it, within 4 r either way: q lies before that line's entry into the media.
+  bool before_entry(const Vec3& q, const Vec3& d, double r) const;
   // source_blur (eq. D14): T_cam's light read at a point of the lateral footprint around p, zero outside
   // the media (the forward peak alone stays on the ray: add_sources at p).
   void add_blurred_sources(const Vec3& p, const Vec3& d, const ShBasis& y_out, double t, const CameraPoint& y,

@@ -48,6 +48,7 @@ MfsSettings mfs_settings_from_json(const nlohmann::json& options, const std::str
   s.source_blur = o.boolean("source_blur", s.source_blur);
   s.camera_tilt = o.boolean("camera_tilt", s.camera_tilt);
   s.camera_shift = o.boolean("camera_shift", s.camera_shift);
+  s.entry_loss = o.boolean("entry_loss", s.entry_loss);
   s.grid_denoise = o.boolean("grid_denoise", s.grid_denoise);
   s.peak_toward_camera = o.boolean("peak_toward_camera", s.peak_toward_camera);
   if (bool b = false; o.keyword_or_boolean("exact_light_transmittance", "auto", &b))
@@ -85,6 +86,7 @@ nlohmann::json to_json(const MfsSettings& s) {
                       {"source_blur", s.source_blur},
                       {"camera_tilt", s.camera_tilt},
                       {"camera_shift", s.camera_shift},
+                      {"entry_loss", s.entry_loss},
                       {"grid_denoise", s.grid_denoise},
                       {"peak_toward_camera", s.peak_toward_camera},
                       {"shadow_map_resolution", s.shadow_map_resolution}};

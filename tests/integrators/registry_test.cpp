@@ -78,6 +78,7 @@ TEST(Registry, SettingsRoundTripThroughJson) {
                                               {"source_blur", true},
                                               {"camera_tilt", false},
                                               {"camera_shift", true},
+                                              {"entry_loss", false},
                                               {"peak_toward_camera", true},
                                               {"exact_light_transmittance", true},
                                               {"shadow_map_resolution", 32}});
@@ -97,12 +98,13 @@ TEST(Registry, DefaultsAreWrittenOut) {
   EXPECT_EQ(mfs["photon_splat"], "trilinear");
   EXPECT_EQ(mfs["camera_tilt"], true);
   EXPECT_EQ(mfs["camera_shift"], false);
+  EXPECT_EQ(mfs["entry_loss"], true);
   EXPECT_EQ(mfs["exact_light_transmittance"], "auto");
   EXPECT_EQ(mfs["beam_spread"], "straight");
   EXPECT_EQ(mfs["beam_photons"], "auto");
   EXPECT_EQ(mfs["beam_smoothing"], 2);
   EXPECT_EQ(mfs["grid_denoise"], true);
-  EXPECT_EQ(mfs.size(), 27u);  // every option of the table in mfs.h
+  EXPECT_EQ(mfs.size(), 28u);  // every option of the table in mfs.h
 }
 
 TEST(Registry, UnknownFieldsAndNamesAreErrors) {
