@@ -214,6 +214,7 @@ MfsIntegrator::Sources MfsIntegrator::step_sources(const MediumPoint& m, const V
     if (bulk) {  // eq. D17: the lights' first wide scatter tilted along their beams' gradients
       CameraPoint y_g = y;
       y_g.gradient_tilt = cam.offset_deflection_covariance(t) * y.sigma_red;
+      y_g.gradient_spread = cam.lateral_spread(t);
       add_sources(m, p, d, d, y_out, t, y_g, cam, rng, true, true, &src);
     } else {
       CameraPoint y_s = y;  // the scattered light: the tilted direction and the residual spread
@@ -313,8 +314,16 @@ MfsIntegrator::MediumRadiance MfsIntegrator::medium_radiance(int i, const Vec3& 
       return;
     }
     const PhaseSplit::Angle a = PhaseSplit::angle(mu);  // once for both terms
+    // eq. D17b: the tilt's exponential weight stops at the medium's surface towards the light, about
+    // -ln(T_wide) / sigma_red away along wi (the tilt's direction is wi's part across d: that over sin).
+    double k = y.gradient_tilt;
+    if (k > 0.0) {
+      const double mu_s = dot(d_s, ls.wi), sin_s = std::sqrt(std::max(0.0, 1.0 - mu_s * mu_s));
+      const double depth = -std::log(std::clamp(max_component(beam.T_wide), 1e-300, 1.0)) / y.sigma_red;
+      k = truncated_gradient_tilt(k, y.sigma_red * sin_s, y.gradient_spread, depth / std::max(sin_s, 1e-3));
+    }
     const PhaseSplit::Angle a_s =  // the scattered light's: camera_tilt's (D16) or camera_shift's (D17)
-        y.gradient_tilt > 0.0 ? PhaseSplit::angle(dot(gradient_tilted(d_s, ls.wi, y.gradient_tilt), ls.wi))
+        y.gradient_tilt > 0.0 ? PhaseSplit::angle(dot(gradient_tilted(d_s, ls.wi, k), ls.wi))
         : tilted              ? PhaseSplit::angle(dot(d_s, ls.wi))
                               : a;
     if (s_.large_angle_scatters != 0)  // eq. D7, first term

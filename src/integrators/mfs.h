@@ -19,8 +19,8 @@
 //    blurred by the camera-side peak depth (D12), optionally pre-filtered over the camera-side lateral
 //    spread (D10).
 // Near a medium's side the scattered light's direction is tilted towards the medium, as the camera-side
-// peak-scattered paths that stay in it are (camera_tilt, D16); optionally, in the bulk, the lights' first
-// wide scatter is read in the direction tilted along the beam's gradient (camera_shift, D17). Where the
+// peak-scattered paths that stay in it are (camera_tilt, D16); in the bulk, the lights' first wide
+// scatter is read in the direction tilted along the beam's gradient (camera_shift, D17). Where the
 // footprint leaves through the face the ray entered by, its scattered light is lost (entry_loss, D18).
 // Camera-side light is attenuated by the reduced extinction (times the 1 / cosh path lengthening, D5,
 // with path_lengthening). forward_side "light" (D11) instead spreads everything on the light's side and
@@ -55,7 +55,7 @@
 // | `filtered_lookups`        | boolean                       | false     | scatter grid read pre-filtered over the camera-side lateral spread |
 // | `source_blur`             | boolean                       | false     | the source (sigma_s times every scattered term) read at a point drawn from the camera-side lateral footprint (D10), so rays near a boundary gather partly outside the medium |
 // | `camera_tilt`             | boolean                       | true      | near a medium's side, the camera-bound light's direction is tilted towards the medium, as the peak-scattered paths that stayed in it are (D16; ignored with source_blur, forward_side "light" and light_path "beer_lambert") |
-// | `camera_shift`            | boolean                       | false     | in the bulk (both footprint points in a medium), the lights' first wide scatter read in the direction tilted towards each light by cov(offset, deflection) sigma_red: the correlation of the footprint's offset with its deflection along the beam's gradient (D17; with camera_tilt only) |
+// | `camera_shift`            | boolean                       | true      | in the bulk (both footprint points in a medium), the lights' first wide scatter read in the direction tilted towards each light by cov(offset, deflection) sigma_red: the correlation of the footprint's offset with its deflection along the beam's gradient (D17), the beam's growth cut at the medium's surface towards the light (D17b; with camera_tilt only) |
 // | `entry_loss`              | boolean                       | true      | where a footprint offset of a march step (with camera_tilt) lies outside the media before the entry of the line through it along the ray (the camera-bound paths displaced there left through the face the ray came in by, and no light beyond the ray's chord makes up for them), the scattered light of that half of the footprint is lost (D18) |
 // | `peak_toward_camera`      | boolean                       | false     | the forward peak alone takes its angular factor from the beam grid's photons (their P_peak towards the camera) instead of peak_eff at the beam's mean-cosine depth (one medium only) |
 // | `exact_light_transmittance` | "auto" or boolean           | "auto"    | T_light and T_wide to directional and point lights without the shadow maps: the chord in closed form for one constant-density sphere or box, else a march ("auto": true for one constant-density sphere or box, else false; the header of a rendered image holds the choice) |
@@ -115,7 +115,7 @@ struct MfsSettings {
   bool filtered_lookups = false;
   bool source_blur = false;
   bool camera_tilt = true;
-  bool camera_shift = false;
+  bool camera_shift = true;
   bool entry_loss = true;
   bool grid_denoise = true;
   bool peak_toward_camera = false;

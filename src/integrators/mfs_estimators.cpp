@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 
 namespace nimbus {
 
@@ -82,6 +83,15 @@ Vec3 survivor_direction(const CameraPath& cam, double t, const Vec3& d, const Ve
 
 Vec3 gradient_tilted(const Vec3& d, const Vec3& wi, double k) {
   return normalize(d + (wi - d * dot(wi, d)) * k);
+}
+
+double truncated_gradient_tilt(double k, double a, double s, double D) {
+  if (!(a > 0.0) || !(s > 0.0) || !(D < std::numeric_limits<double>::infinity())) return k;
+  const double z = (D - a * s * s) / s;
+  // lambda(z) = phi(z) / Phi(z); for z far below 0, Phi's tail makes it -z (its asymptote, to 1 / z^2).
+  const double Phi = 0.5 * std::erfc(-z / std::sqrt(2.0));
+  const double lambda = Phi > 1e-300 ? std::exp(-0.5 * z * z) / std::sqrt(2.0 * kPi) / Phi : -z;
+  return k * std::max(0.0, 1.0 - lambda / (a * s));
 }
 
 namespace {

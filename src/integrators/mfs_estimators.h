@@ -37,8 +37,9 @@ struct CameraPoint {
   Rgb T_full;  // plain transmittance y -> camera (the forward-peak paths' last leg, eq. D7)
   Rgb T_cam;   // transmittance of light scattered at y: T_red (times eq. D5) or, light side, T_full
   Rgb tau_p;   // camera-side peak depth at y
-  double sigma_red = 0.0;      // the reduced extinction at y (largest channel)
-  double gradient_tilt = 0.0;  // camera_shift's k (eq. D17; 0: none)
+  double sigma_red = 0.0;        // the reduced extinction at y (largest channel)
+  double gradient_tilt = 0.0;    // camera_shift's k (eq. D17; 0: none)
+  double gradient_spread = 0.0;  // and the footprint's lateral spread there (eq. D17b)
 };
 
 // The camera-side state along the march, from the camera to the current step's start (eqs. D2, D5, D10):
@@ -92,6 +93,12 @@ Vec3 survivor_direction(const CameraPath& cam, double t, const Vec3& d, const Ve
 // direction towards a light whose beam grows at the rate sigma_red towards it, by
 // k = cov(u, delta) sigma_red: normalize(d + k (wi - (wi . d) d)).
 Vec3 gradient_tilted(const Vec3& d, const Vec3& wi, double k);
+// camera_shift's k where the medium ends towards the light (eq. D17b): the footprint's Gaussian offset u
+// (standard deviation s) along the tilt's direction, weighted by the beam's growth exp(a u) and cut at the
+// medium's surface a distance D away along it (past it nothing scatters), has the mean a s^2 - s lambda(z),
+// lambda = phi / Phi (the inverse Mills ratio) at z = (D - a s^2) / s; the tilt is k times that mean over
+// the uncut a s^2, at least 0. k where D is infinite (or a, s are 0).
+double truncated_gradient_tilt(double k, double a, double s, double D);
 
 // A point of the lateral footprint around the camera ray (direction d) at standard deviation sigma per
 // component (eq. D10): a 2-D Gaussian offset perpendicular to d by Box-Muller from u1, u2 (eq. D14).

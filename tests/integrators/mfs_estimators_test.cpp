@@ -105,6 +105,30 @@ TEST(MfsEstimators, GradientTiltIsTheGaussianShiftOfTheDeflection) {
   EXPECT_NEAR((along - d).length(), 0.0, 1e-15);
 }
 
+// camera_shift's tilt cut at the medium's surface (eq. D17b): k times the mean offset under the weight
+// exp(a u) on u < D, by quadrature, over the uncut mean a s^2; k itself far from the surface, and 0 where
+// the cut mean turns away from the light.
+TEST(MfsEstimators, TruncatedGradientTiltIsTheCutWeightsMeanOffset) {
+  const double k = 0.7, a = 3.0, s = 0.2;
+  for (const double D : {0.02, 0.1, 0.2, 0.4, 1.0}) {
+    double w = 0.0, wu = 0.0;
+    const int n = 200001;
+    const double lo = -12.0 * s, h = (D - lo) / (n - 1);
+    for (int i = 0; i < n; ++i) {  // the trapezoidal rule over [lo, D]
+      const double u = lo + i * h,
+                   p = std::exp(-0.5 * u * u / (s * s) + a * u) * (i == 0 || i == n - 1 ? 0.5 : 1.0);
+      w += p;
+      wu += p * u;
+    }
+    const double expected = k * std::max(0.0, (wu / w) / (a * s * s));
+    EXPECT_NEAR(truncated_gradient_tilt(k, a, s, D), expected, 1e-6) << D;
+  }
+  EXPECT_NEAR(truncated_gradient_tilt(k, a, s, 20.0), k, 1e-12);
+  EXPECT_EQ(truncated_gradient_tilt(k, a, s, std::numeric_limits<double>::infinity()), k);
+  EXPECT_EQ(truncated_gradient_tilt(k, a, s, 0.0), 0.0);  // the cut mean is below 0
+  EXPECT_LT(truncated_gradient_tilt(k, a, s, 0.2), 0.8 * k);
+}
+
 TEST(MfsEstimators, FootprintProbeHasTheFootprintsMoments) {
   const Vec3 d = normalize(Vec3(0.3, -0.5, 0.8));
   const double sigma = 0.5;

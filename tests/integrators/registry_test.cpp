@@ -77,7 +77,7 @@ TEST(Registry, SettingsRoundTripThroughJson) {
                                               {"filtered_lookups", true},
                                               {"source_blur", true},
                                               {"camera_tilt", false},
-                                              {"camera_shift", true},
+                                              {"camera_shift", false},
                                               {"entry_loss", false},
                                               {"peak_toward_camera", true},
                                               {"exact_light_transmittance", true},
@@ -97,7 +97,7 @@ TEST(Registry, DefaultsAreWrittenOut) {
   EXPECT_EQ(mfs["light_path"], "forward");
   EXPECT_EQ(mfs["photon_splat"], "trilinear");
   EXPECT_EQ(mfs["camera_tilt"], true);
-  EXPECT_EQ(mfs["camera_shift"], false);
+  EXPECT_EQ(mfs["camera_shift"], true);
   EXPECT_EQ(mfs["entry_loss"], true);
   EXPECT_EQ(mfs["exact_light_transmittance"], "auto");
   EXPECT_EQ(mfs["beam_spread"], "straight");
