@@ -39,6 +39,8 @@ CONFIGS = [  # (label, integrator block, spp)
     ("mfs path lengthening", {"type": "mfs", "path_lengthening": True}, 4),
     ("mfs source blur", {"type": "mfs", "source_blur": True}, 4),
     ("mfs no tilt", {"type": "mfs", "camera_tilt": False}, 4),
+    ("mfs no shift", {"type": "mfs", "camera_shift": False}, 4),
+    ("mfs no entry loss", {"type": "mfs", "entry_loss": False}, 4),
     ("mfs beer_lambert", {"type": "mfs", "light_path": "beer_lambert"}, 4),
     ("mfs gaussian", {"type": "mfs", "propagator": "gaussian"}, 4),
     ("mfs f=0", {"type": "mfs", "peak_fraction": 0.0}, 4),
