@@ -1200,8 +1200,8 @@ int box_entry_axis(const SceneContext& ctx, int x, int y) {
 // entry_loss (eq. D18) on the grey box's top face, which the camera rays enter at 19 degrees, paths with
 // at most one wide scatter against the path tracer's tally of them: the camera-bound paths that peak
 // scatters displace upwards leave through the face the ray came in by, and nothing past the ray's chord
-// makes up for them. Over the pixels whose rays enter through the top face `mfs` is 23 % too bright
-// without the loss and 16 % with it (measured; most of the rest is the beam's loss through the same face,
+// makes up for them. Over the pixels whose rays enter through the top face `mfs` is 24 % too bright
+// without the loss and 18 % with it (measured; most of the rest is the beam's loss through the same face,
 // which the beam grid resolves coarsely): the loss must take it 3 % of the path tracer's light closer at
 // least (the path tracer's noise there is about 0.5 %).
 TEST(Mfs, EntryLossDarkensTheGrazedTopFace) {
