@@ -314,18 +314,12 @@ MfsIntegrator::MediumRadiance MfsIntegrator::medium_radiance(int i, const Vec3& 
       return;
     }
     const PhaseSplit::Angle a = PhaseSplit::angle(mu);  // once for both terms
-    // eq. D17b: the tilt's exponential weight stops at the medium's surface towards the light, about
-    // -ln(T_wide) / sigma_red away along wi (the tilt's direction is wi's part across d: that over sin).
-    double k = y.gradient_tilt;
-    if (k > 0.0) {
-      const double mu_s = dot(d_s, ls.wi), sin_s = std::sqrt(std::max(0.0, 1.0 - mu_s * mu_s));
-      const double depth = -std::log(std::clamp(max_component(beam.T_wide), 1e-300, 1.0)) / y.sigma_red;
-      k = truncated_gradient_tilt(k, y.sigma_red * sin_s, y.gradient_spread, depth / std::max(sin_s, 1e-3));
-    }
-    const PhaseSplit::Angle a_s =  // the scattered light's: camera_tilt's (D16) or camera_shift's (D17)
-        y.gradient_tilt > 0.0 ? PhaseSplit::angle(dot(gradient_tilted(d_s, ls.wi, k), ls.wi))
-        : tilted              ? PhaseSplit::angle(dot(d_s, ls.wi))
-                              : a;
+    const PhaseSplit::Angle a_s =  // the scattered light's: camera_tilt's (D16) or camera_shift's (D17, D17b)
+        y.gradient_tilt > 0.0
+            ? PhaseSplit::angle(
+                  dot(gradient_tilted(d_s, ls.wi, cut_gradient_tilt(y, d_s, ls.wi, beam.T_wide)), ls.wi))
+        : tilted ? PhaseSplit::angle(dot(d_s, ls.wi))
+                 : a;
     if (s_.large_angle_scatters != 0)  // eq. D7, first term
       out.L += first_wide_scatter(ls.weight, f, split, a_s, y.tau_p, s_.light_blur ? beam.tau_ps : Rgb(0.0),
                                   beam.T_wide);

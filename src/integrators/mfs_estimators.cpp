@@ -94,6 +94,14 @@ double truncated_gradient_tilt(double k, double a, double s, double D) {
   return k * std::max(0.0, 1.0 - lambda / (a * s));
 }
 
+double cut_gradient_tilt(const CameraPoint& y, const Vec3& d_s, const Vec3& wi, const Rgb& T_wide) {
+  if (!(y.gradient_tilt > 0.0) || !(y.sigma_red > 0.0)) return y.gradient_tilt;
+  const double mu = dot(d_s, wi), sin_t = std::sqrt(std::max(0.0, 1.0 - mu * mu));
+  const double depth = -std::log(std::clamp(max_component(T_wide), 1e-300, 1.0)) / y.sigma_red;
+  return truncated_gradient_tilt(y.gradient_tilt, y.sigma_red * sin_t, y.gradient_spread,
+                                 depth / std::max(sin_t, 1e-3));
+}
+
 namespace {
 
 // The Rayleigh distribution's strata midpoints, sqrt(-2 ln(1 - (k + 1/2) / n)), scaled to mean square 2.

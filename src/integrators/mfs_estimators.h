@@ -99,6 +99,10 @@ Vec3 gradient_tilted(const Vec3& d, const Vec3& wi, double k);
 // lambda = phi / Phi (the inverse Mills ratio) at z = (D - a s^2) / s; the tilt is k times that mean over
 // the uncut a s^2, at least 0. k where D is infinite (or a, s are 0).
 double truncated_gradient_tilt(double k, double a, double s, double D);
+// y.gradient_tilt towards a light along wi (from d_s) cut by truncated_gradient_tilt at the medium's surface
+// towards it: a = sigma_red sin theta (theta between d_s and wi), s = y.gradient_spread and D the light-side
+// distance -ln(T_wide) / sigma_red (T_wide's largest channel) over sin theta (a surface normal to wi).
+double cut_gradient_tilt(const CameraPoint& y, const Vec3& d_s, const Vec3& wi, const Rgb& T_wide);
 
 // A point of the lateral footprint around the camera ray (direction d) at standard deviation sigma per
 // component (eq. D10): a 2-D Gaussian offset perpendicular to d by Box-Muller from u1, u2 (eq. D14).
