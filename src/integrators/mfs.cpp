@@ -27,6 +27,8 @@ MfsIntegrator::MfsIntegrator(const SceneContext& context, MfsSettings settings, 
     splits_.push_back(std::make_unique<PhaseSplit>(phase, f, s_.propagator == Propagator::gaussian));
     f_.push_back(splits_.back()->f());
     theta2_.push_back(splits_.back()->theta2());
+    const std::vector<double>& chi = splits_.back()->peak_moments();
+    drift_.push_back(f_.back() > 0.0 && chi.size() > 1 ? std::max(0.0, 1.0 - chi[1]) : 0.0);
   }
   double cut_angle = 0.0;  // the widest peak's, for "auto" beam photons
   for (const auto& sp : splits_)
@@ -160,11 +162,11 @@ Rgb MfsIntegrator::trace(const Ray& ray, Rng& rng, CameraSample* sample, int bou
     ++mfs_march_steps;
     // Split the extinction at p into peak and reduced parts (eq. D2).
     ctx_.media.eval(p, &mp);
-    const MfsExtinction k = mfs_extinction(mp, f_, theta2_);
+    const MfsExtinction k = mfs_extinction(mp, f_, theta2_, drift_);
     Rgb L_step(0.0);
     // Add what each medium scatters towards the camera at the sample point y = p.
     if (max_component(mp.sigma_s) > 0.0) {
-      const CameraPoint y = cam.at(k, jitter, dt, s_.light_side(), s_.path_lengthening);
+      const CameraPoint y = cam.at(k, jitter, dt, s_.light_side(), s_.path_lengthening, s_.camera_fluence);
       const Sources src = step_sources(mp, p, d, y_out, t, y, cam, rng, probe ? &*probe : nullptr);
       L_step = (y.T_cam * src.in_scatter + y.T_full * src.peak_scatter) * dt;
       L += L_step;

@@ -51,7 +51,8 @@
 // | `beam_smoothing`          | integer in [0, 8]             | 2         | passes of the filter [1 2 1] / 4 along each axis over the beam grid's nodes inside the media (0: none): the grid's noise averaged over about one node spacing (BeamGrid) |
 // | `photon_splat`            | "trilinear", "stochastic" or "stratified" | "trilinear" | how the scatter grid's photons deposit each track sample: over the 8 nodes around it, or whole to one of them drawn by its trilinear weight (independently, or stratified along the track); the same expected grid, more noise (the beam grid stays trilinear) |
 // | `light_blur`              | boolean                       | true      | the first wide scatter sees the beam's light-side angular spread |
-// | `path_lengthening`        | boolean                       | false     | the corrected kernel's 1 / cosh loss on paths lengthened by peak deflections |
+// | `path_lengthening`        | boolean                       | false     | the corrected kernel's 1 / cosh loss on paths lengthened by peak deflections (replaces camera_fluence) |
+// | `camera_fluence`          | boolean                       | false     | the light scattered towards the camera carried by the camera-side peak beam's fluence, not its flux: its deflected paths gather more of the medium per unit depth and lose more to sigma_red (D19; the half-space's answer, not the default: docs/benchmarks.md) |
 // | `filtered_lookups`        | boolean                       | false     | scatter grid read pre-filtered over the camera-side lateral spread |
 // | `source_blur`             | boolean                       | false     | the source (sigma_s times every scattered term) read at a point drawn from the camera-side lateral footprint (D10), so rays near a boundary gather partly outside the medium |
 // | `camera_tilt`             | boolean                       | true      | near a medium's side, the camera-bound light's direction is tilted towards the medium, as the peak-scattered paths that stayed in it are (D16; ignored with source_blur, forward_side "light" and light_path "beer_lambert") |
@@ -112,6 +113,7 @@ struct MfsSettings {
   Splat photon_splat = Splat::trilinear;
   bool light_blur = true;
   bool path_lengthening = false;
+  bool camera_fluence = false;
   bool filtered_lookups = false;
   bool source_blur = false;
   bool camera_tilt = true;
@@ -160,6 +162,7 @@ class MfsIntegrator final : public Integrator {
   std::vector<std::unique_ptr<PhaseSplit>> splits_;          // per medium
   std::vector<double> f_;                                    // per medium peak fraction
   std::vector<double> theta2_;                               // per medium peak's mean square angle
+  std::vector<double> drift_;                                // per medium 1 - chi_1 of its peak (eq. D19)
   std::vector<TransmittanceGrid> full_maps_, reduced_maps_;  // per light
   std::unique_ptr<ScatterGrid> grid_;                        // wide scatters 2 .. K (null for K = 1)
   std::unique_ptr<BeamGrid> beam_;                           // the peak-only beams' correction (or null)

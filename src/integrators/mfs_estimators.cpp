@@ -16,34 +16,43 @@ double path_lengthening(double theta, double tau) {
 }
 
 MfsExtinction mfs_extinction(const MediumPoint& mp, const std::vector<double>& f,
-                             const std::vector<double>& theta2) {
+                             const std::vector<double>& theta2, const std::vector<double>& drift) {
   // eq. D2: the peak part of each medium's scattering is not extinction for forward-carried light.
   MfsExtinction k;
   k.sigma_t = mp.sigma_t();
   k.sigma_peak = Rgb(0.0);
   k.sigma_theta = Rgb(0.0);
+  k.sigma_drift = Rgb(0.0);
   for (int i = 0; i < mp.count; ++i) {
     k.sigma_peak += mp.sigma_s_i[i] * f[i];
     k.sigma_theta += mp.sigma_s_i[i] * (f[i] * theta2[i]);
+    if (size_t(i) < drift.size()) k.sigma_drift += mp.sigma_s_i[i] * (f[i] * drift[size_t(i)]);
   }
   k.sigma_red = k.sigma_t - k.sigma_peak;
   return k;
 }
 
 CameraPoint CameraPath::at(const MfsExtinction& k, double jitter, double dt, bool light_side,
-                           bool lengthening) const {
+                           bool lengthening, bool fluence) const {
   CameraPoint y;
   y.T_full = T_full * exp_channels(-k.sigma_t * (jitter * dt));
   if (light_side) {
     y.T_cam = y.T_full;
-  } else {
+  } else if (lengthening) {
     // Light scattered at y is carried to the camera by the propagator: only absorption and wide
     // scatters remove it (eq. D2), and its lengthened paths lose eq. D5.
     y.T_cam = T_red * exp_channels(-k.sigma_red * (jitter * dt));
-    if (lengthening)
-      for (int c = 0; c < 3; ++c)
-        y.T_cam[c] *= path_lengthening(theta_p[c] + k.sigma_theta[c] * jitter * dt,
-                                       tau_red[c] + k.sigma_red[c] * jitter * dt);
+    for (int c = 0; c < 3; ++c)
+      y.T_cam[c] *= path_lengthening(theta_p[c] + k.sigma_theta[c] * jitter * dt,
+                                     tau_red[c] + k.sigma_red[c] * jitter * dt);
+  } else if (fluence) {
+    // Eq. D19: the camera-side beam's fluence e^A_y times its flux exp(-tau_red - D_y), in one exp.
+    const double h = jitter * dt;
+    y.T_cam =
+        T_red * exp_channels(drift + k.sigma_drift * h - detour - k.sigma_red * h -
+                             k.sigma_red * (exp_channels(drift + k.sigma_drift * (0.5 * h)) - Rgb(1.0)) * h);
+  } else {
+    y.T_cam = T_red * exp_channels(-k.sigma_red * (jitter * dt));
   }
   y.tau_p = tau_p + k.sigma_peak * (jitter * dt);
   y.sigma_red = max_component(k.sigma_red);
@@ -56,6 +65,11 @@ void CameraPath::advance(const MfsExtinction& k, double t, double dt, double jit
   tau_p += k.sigma_peak * dt;
   theta_p += k.sigma_theta * dt;
   tau_red += k.sigma_red * dt;
+  // eq. D19's detour depth over the step (the drift depth at its midpoint), then the drift depth.
+  if (max_component(k.sigma_drift) > 0.0 || max_component(drift) > 0.0) {
+    detour += k.sigma_red * (exp_channels(drift + k.sigma_drift * (0.5 * dt)) - Rgb(1.0)) * dt;
+    drift += k.sigma_drift * dt;
+  }
   // eq. D10's moments, by the midpoint rule over the step.
   const double a = max_component(k.sigma_theta) * dt, tm = t + (0.5 - jitter) * dt;
   m0 += a;

@@ -25,17 +25,20 @@ double path_lengthening(double theta, double tau);
 
 // The peak split of the extinction at a point, summed over the media present (eq. D2):
 //     sigma_peak = sum_i f_i sigma_s_i, sigma_theta = sum_i f_i theta2_i sigma_s_i,
-//     sigma_red = sigma_t - sigma_peak (the reduced extinction: absorption and wide scatters).
+//     sigma_red = sigma_t - sigma_peak (the reduced extinction: absorption and wide scatters),
+//     sigma_drift = sum_i f_i (1 - chi_1,i) sigma_s_i (the rate at which peak scatters turn the mean
+//     cosine of forward-carried light away from its axis, eq. D19; drift_i = 1 - chi_1 of medium i's
+//     peak, none: 0).
 struct MfsExtinction {
-  Rgb sigma_t, sigma_peak, sigma_theta, sigma_red;
+  Rgb sigma_t, sigma_peak, sigma_theta, sigma_red, sigma_drift{0.0};
 };
 MfsExtinction mfs_extinction(const MediumPoint& mp, const std::vector<double>& f,
-                             const std::vector<double>& theta2);
+                             const std::vector<double>& theta2, const std::vector<double>& drift = {});
 
 // What the camera-side state gives at the march's sample point y.
 struct CameraPoint {
   Rgb T_full;  // plain transmittance y -> camera (the forward-peak paths' last leg, eq. D7)
-  Rgb T_cam;   // transmittance of light scattered at y: T_red (times eq. D5) or, light side, T_full
+  Rgb T_cam;   // transmittance of light scattered at y: T_red (times eq. D5 or D19) or, light side, T_full
   Rgb tau_p;   // camera-side peak depth at y
   double sigma_red = 0.0;        // the reduced extinction at y (largest channel)
   double gradient_tilt = 0.0;    // camera_shift's k (eq. D17; 0: none)
@@ -45,16 +48,18 @@ struct CameraPoint {
 // The camera-side state along the march, from the camera to the current step's start (eqs. D2, D5, D10):
 // T_full = exp(-tau_t), T_red = exp(-tau_red), the peak depth tau_p, the angular diffusion
 // theta_p = int theta2 dtau_p, and the lateral-spread moments m_k = int theta2 sigma_peak s^k ds
-// (k = 0, 1, 2, s from the ray's origin, largest channel).
+// (k = 0, 1, 2, s from the ray's origin, largest channel); eq. D19's drift depth A = int sigma_drift ds
+// and detour depth D = int sigma_red (e^A - 1) ds.
 struct CameraPath {
-  Rgb T_full{1.0}, T_red{1.0}, tau_p{0.0}, theta_p{0.0}, tau_red{0.0};
+  Rgb T_full{1.0}, T_red{1.0}, tau_p{0.0}, theta_p{0.0}, tau_red{0.0}, drift{0.0}, detour{0.0};
   double m0 = 0.0, m1 = 0.0, m2 = 0.0;
 
   // The state at the sample point y = jitter dt into the step (the march's offset).
   // light_side: light scattered at y goes to the camera unscattered (T_cam = T_full); otherwise it is
-  // carried by the propagator (T_cam = T_red, times eq. D5 when path_lengthening).
-  CameraPoint at(const MfsExtinction& k, double jitter, double dt, bool light_side,
-                 bool path_lengthening) const;
+  // carried by the propagator (T_cam = T_red, times eq. D5 when path_lengthening, else times eq. D19's
+  // fluence factor e^(A - D) when fluence).
+  CameraPoint at(const MfsExtinction& k, double jitter, double dt, bool light_side, bool path_lengthening,
+                 bool fluence = false) const;
   // The whole step [t - jitter dt, t + (1 - jitter) dt] (moments at its midpoint).
   void advance(const MfsExtinction& k, double t, double dt, double jitter);
   // Lateral standard deviation of the light that reaches the camera from depth t (eq. D10).

@@ -44,6 +44,7 @@ MfsSettings mfs_settings_from_json(const nlohmann::json& options, const std::str
   s.photon_splat = Splat(o.choice("photon_splat", kSplatNames, int(s.photon_splat)));
   s.light_blur = o.boolean("light_blur", s.light_blur);
   s.path_lengthening = o.boolean("path_lengthening", s.path_lengthening);
+  s.camera_fluence = o.boolean("camera_fluence", s.camera_fluence);
   s.filtered_lookups = o.boolean("filtered_lookups", s.filtered_lookups);
   s.source_blur = o.boolean("source_blur", s.source_blur);
   s.camera_tilt = o.boolean("camera_tilt", s.camera_tilt);
@@ -82,6 +83,7 @@ nlohmann::json to_json(const MfsSettings& s) {
                       {"photon_splat", kSplatNames[int(s.photon_splat)]},
                       {"light_blur", s.light_blur},
                       {"path_lengthening", s.path_lengthening},
+                      {"camera_fluence", s.camera_fluence},
                       {"filtered_lookups", s.filtered_lookups},
                       {"source_blur", s.source_blur},
                       {"camera_tilt", s.camera_tilt},

@@ -74,6 +74,7 @@ TEST(Registry, SettingsRoundTripThroughJson) {
                                               {"photon_splat", "stratified"},
                                               {"light_blur", false},
                                               {"path_lengthening", true},
+                                              {"camera_fluence", true},
                                               {"filtered_lookups", true},
                                               {"source_blur", true},
                                               {"camera_tilt", false},
@@ -104,7 +105,8 @@ TEST(Registry, DefaultsAreWrittenOut) {
   EXPECT_EQ(mfs["beam_photons"], "auto");
   EXPECT_EQ(mfs["beam_smoothing"], 2);
   EXPECT_EQ(mfs["grid_denoise"], true);
-  EXPECT_EQ(mfs.size(), 28u);  // every option of the table in mfs.h
+  EXPECT_EQ(mfs["camera_fluence"], false);
+  EXPECT_EQ(mfs.size(), 29u);  // every option of the table in mfs.h
 }
 
 TEST(Registry, UnknownFieldsAndNamesAreErrors) {
