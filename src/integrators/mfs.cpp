@@ -27,8 +27,10 @@ MfsIntegrator::MfsIntegrator(const SceneContext& context, MfsSettings settings, 
     splits_.push_back(std::make_unique<PhaseSplit>(phase, f, s_.propagator == Propagator::gaussian));
     f_.push_back(splits_.back()->f());
     theta2_.push_back(splits_.back()->theta2());
+    // eq. D19's drift rates, only where camera_fluence reads them (else the march keeps no drift depth).
     const std::vector<double>& chi = splits_.back()->peak_moments();
-    drift_.push_back(f_.back() > 0.0 && chi.size() > 1 ? std::max(0.0, 1.0 - chi[1]) : 0.0);
+    if (s_.camera_fluence && !s_.path_lengthening)
+      drift_.push_back(f_.back() > 0.0 && chi.size() > 1 ? std::max(0.0, 1.0 - chi[1]) : 0.0);
   }
   double cut_angle = 0.0;  // the widest peak's, for "auto" beam photons
   for (const auto& sp : splits_)

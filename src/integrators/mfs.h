@@ -23,8 +23,9 @@
 // scatter is read in the direction tilted along the beam's gradient (camera_shift, D17). Where the
 // footprint leaves through the face the ray entered by, its scattered light is lost (entry_loss, D18).
 // Camera-side light is attenuated by the reduced extinction (times the 1 / cosh path lengthening, D5,
-// with path_lengthening). forward_side "light" (D11) instead spreads everything on the light's side and
-// takes the camera leg exactly. Light transmittances come from deep shadow maps (deterministic); the
+// with path_lengthening, or the camera-side beam's fluence factor, D19, with camera_fluence).
+// forward_side "light" (D11) instead spreads everything on the light's side and takes the camera leg
+// exactly. Light transmittances come from deep shadow maps (deterministic); the
 // environment is carried by the scatter grid from its entry. Every channel uses its own optical depths;
 // overlapping media share one tau_p (sum of f_i sigma_s_i).
 //
@@ -159,10 +160,10 @@ class MfsIntegrator final : public Integrator {
  private:
   const SceneContext& ctx_;
   MfsSettings s_;
-  std::vector<std::unique_ptr<PhaseSplit>> splits_;          // per medium
-  std::vector<double> f_;                                    // per medium peak fraction
-  std::vector<double> theta2_;                               // per medium peak's mean square angle
-  std::vector<double> drift_;                                // per medium 1 - chi_1 of its peak (eq. D19)
+  std::vector<std::unique_ptr<PhaseSplit>> splits_;  // per medium
+  std::vector<double> f_;                            // per medium peak fraction
+  std::vector<double> theta2_;                       // per medium peak's mean square angle
+  std::vector<double> drift_;                        // per medium 1 - chi_1 of its peak (eq. D19; empty: off)
   std::vector<TransmittanceGrid> full_maps_, reduced_maps_;  // per light
   std::unique_ptr<ScatterGrid> grid_;                        // wide scatters 2 .. K (null for K = 1)
   std::unique_ptr<BeamGrid> beam_;                           // the peak-only beams' correction (or null)
