@@ -19,6 +19,17 @@
 
 namespace nimbus {
 
+namespace {
+
+// eq. D19's drift rate per unit peak depth, 1 - chi_1 of the peak (0 without one). Only with camera_fluence:
+// otherwise the march keeps no drift depth.
+double peak_drift(const PhaseSplit& split) {
+  const std::vector<double>& chi = split.peak_moments();
+  return split.f() > 0.0 && chi.size() > 1 ? std::max(0.0, 1.0 - chi[1]) : 0.0;
+}
+
+}  // namespace
+
 MfsIntegrator::MfsIntegrator(const SceneContext& context, MfsSettings settings, uint64_t seed)
     : ctx_(context), s_(settings) {
   for (int i = 0; i < ctx_.media.count(); ++i) {
@@ -27,10 +38,7 @@ MfsIntegrator::MfsIntegrator(const SceneContext& context, MfsSettings settings, 
     splits_.push_back(std::make_unique<PhaseSplit>(phase, f, s_.propagator == Propagator::gaussian));
     f_.push_back(splits_.back()->f());
     theta2_.push_back(splits_.back()->theta2());
-    // eq. D19's drift rates, only where camera_fluence reads them (else the march keeps no drift depth).
-    const std::vector<double>& chi = splits_.back()->peak_moments();
-    if (s_.camera_fluence && !s_.path_lengthening)
-      drift_.push_back(f_.back() > 0.0 && chi.size() > 1 ? std::max(0.0, 1.0 - chi[1]) : 0.0);
+    if (s_.camera_fluence && !s_.path_lengthening) drift_.push_back(peak_drift(*splits_.back()));  // eq. D19
   }
   double cut_angle = 0.0;  // the widest peak's, for "auto" beam photons
   for (const auto& sp : splits_)
