@@ -328,7 +328,8 @@ HalfSpaceLight half_space_light(double kappa) {
     double weight = 1.0, total = 0.0;
     while (weight > 1e-5 && x.z >= 0.0) {
       const double L = -std::log(1.0 - rng.uniform()) / sp, a = sr - kappa * w.z;
-      total += weight * std::exp(kappa * x.z) * -std::expm1(-a * L) / a;
+      const double inside = w.z < 0.0 ? std::min(L, x.z / -w.z) : L;  // no source beyond the surface
+      total += weight * std::exp(kappa * x.z) * -std::expm1(-a * inside) / a;
       x += w * L;
       weight *= std::exp(-sr * L);
       for (int tries = 0; tries < 10000; ++tries) {  // P_peak by rejection from P
