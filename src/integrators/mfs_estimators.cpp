@@ -38,25 +38,26 @@ CameraPoint CameraPath::at(const MfsExtinction& k, double jitter, double dt, boo
   y.T_full = T_full * exp_channels(-k.sigma_t * (jitter * dt));
   if (light_side) {
     y.T_cam = y.T_full;
-  } else if (lengthening) {
-    // Light scattered at y is carried to the camera by the propagator: only absorption and wide
-    // scatters remove it (eq. D2), and its lengthened paths lose eq. D5.
-    y.T_cam = T_red * exp_channels(-k.sigma_red * (jitter * dt));
-    for (int c = 0; c < 3; ++c)
-      y.T_cam[c] *= path_lengthening(theta_p[c] + k.sigma_theta[c] * jitter * dt,
-                                     tau_red[c] + k.sigma_red[c] * jitter * dt);
-  } else if (fluence) {
-    // Eq. D19: the camera-side beam's fluence e^A_y times its flux exp(-tau_red - D_y), in one exp.
-    const double h = jitter * dt;
-    y.T_cam =
-        T_red * exp_channels(drift + k.sigma_drift * h - detour - k.sigma_red * h -
-                             k.sigma_red * (exp_channels(drift + k.sigma_drift * (0.5 * h)) - Rgb(1.0)) * h);
   } else {
-    y.T_cam = T_red * exp_channels(-k.sigma_red * (jitter * dt));
+    // Light scattered at y is carried to the camera by the propagator: only absorption and wide
+    // scatters remove it (eq. D2); its lengthened paths lose eq. D5, or its fluence is eq. D19's.
+    const double h = jitter * dt;
+    y.T_cam = T_red * exp_channels(-k.sigma_red * h);
+    if (lengthening) {
+      for (int c = 0; c < 3; ++c)
+        y.T_cam[c] *= path_lengthening(theta_p[c] + k.sigma_theta[c] * jitter * dt,
+                                       tau_red[c] + k.sigma_red[c] * jitter * dt);
+    } else if (fluence) {
+      y.T_cam *= exp_channels(drift + k.sigma_drift * h - detour - detour_over(k, h));
+    }
   }
   y.tau_p = tau_p + k.sigma_peak * (jitter * dt);
   y.sigma_red = max_component(k.sigma_red);
   return y;
+}
+
+Rgb CameraPath::detour_over(const MfsExtinction& k, double h) const {
+  return k.sigma_red * (exp_channels(drift + k.sigma_drift * (0.5 * h)) - Rgb(1.0)) * h;
 }
 
 void CameraPath::advance(const MfsExtinction& k, double t, double dt, double jitter) {
@@ -67,7 +68,7 @@ void CameraPath::advance(const MfsExtinction& k, double t, double dt, double jit
   tau_red += k.sigma_red * dt;
   // eq. D19's detour depth over the step (the drift depth at its midpoint), then the drift depth.
   if (max_component(k.sigma_drift) > 0.0 || max_component(drift) > 0.0) {
-    detour += k.sigma_red * (exp_channels(drift + k.sigma_drift * (0.5 * dt)) - Rgb(1.0)) * dt;
+    detour += detour_over(k, dt);
     drift += k.sigma_drift * dt;
   }
   // eq. D10's moments, by the midpoint rule over the step.

@@ -60,6 +60,8 @@ struct CameraPath {
   // fluence factor e^(A - D) when fluence).
   CameraPoint at(const MfsExtinction& k, double jitter, double dt, bool light_side, bool path_lengthening,
                  bool fluence = false) const;
+  // Eq. D19's detour depth gained over the next h of path (the drift depth at its midpoint).
+  Rgb detour_over(const MfsExtinction& k, double h) const;
   // The whole step [t - jitter dt, t + (1 - jitter) dt] (moments at its midpoint).
   void advance(const MfsExtinction& k, double t, double dt, double jitter);
   // Lateral standard deviation of the light that reaches the camera from depth t (eq. D10).
