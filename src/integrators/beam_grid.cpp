@@ -1,5 +1,7 @@
 // The beam grid (integrators/beam_grid.h): its photons (through the shared photon tracer) and its
 // lookup.
+// long-file: the photons' deposits and the lookup share the node's column layout (Blocks) and the straight
+// model's helpers of this file's anonymous namespace; a second file would have to expose them.
 #include "integrators/beam_grid.h"
 
 #include <algorithm>
@@ -59,11 +61,13 @@ namespace {
 // Per node, blocks of `channels` floats (3: rgb; 1: grey media under lights of grey strength, whose three
 // channels would be the same numbers), in this order: traced, straight; with the spread (beam_spread
 // "traced"), traced x (1 - cosine) and straight x the straight model's 1 - mean cosine; with a camera
-// (peak_toward), traced x P_peak towards the camera.
+// (peak_toward), traced x P_peak towards the camera; with the wide factor towards the camera (wide_toward),
+// traced x P_wide towards the camera and traced x the straight model's wide_eff there.
 struct Blocks {
-  bool spread, pk;
-  int count() const { return 2 + (spread ? 2 : 0) + (pk ? 1 : 0); }
+  bool spread, pk, wide = false;
+  int count() const { return 2 + (spread ? 2 : 0) + (pk ? 1 : 0) + (wide ? 2 : 0); }
   int pk_block() const { return spread ? 4 : 2; }
+  int wide_block() const { return pk_block() + (pk ? 1 : 0); }
 };
 constexpr double kR2a1 = 0.75487766624669276, kR2a2 = 0.56984029099805327;  // the R2 sequence
 constexpr double kRoulette = 0.05;  // roulette below this ratio of weight to T_wide
@@ -91,9 +95,13 @@ enum class Columns { traced, straight, both };
 
 // Adds v (channel ch of `channels`) with trilinear weights st to the tally: to the straight column (and
 // times spread_s its spread column), to the traced one (and times spread its spread column), or to both;
-// with a P_peak block also the traced v times pk (P_peak towards the camera).
+// with a P_peak block also the traced v times pk (P_peak towards the camera); with the wide blocks the
+// traced v times pw (P_wide towards the camera) and times pm (the straight model's wide factor).
+struct CameraFactors {
+  double pk = 0.0, pw = 0.0, pm = 0.0;
+};
 void splat(float* tally, int channels, Blocks b, const TrilinearStencil& st, int ch, double v, double spread,
-           double spread_s, double pk, Columns to) {
+           double spread_s, const CameraFactors& cf, Columns to) {
   const int stride = channels * b.count();
   for (int j = 0; j < 8; ++j)
     if (st.weight[j] > 0.0) {
@@ -106,7 +114,11 @@ void splat(float* tally, int channels, Blocks b, const TrilinearStencil& st, int
       if (to != Columns::straight) {
         node[0] += float(x);
         if (b.spread) node[2 * channels] += float(x * spread);
-        if (b.pk) node[b.pk_block() * channels] += float(x * pk);
+        if (b.pk) node[b.pk_block() * channels] += float(x * cf.pk);
+        if (b.wide) {
+          node[b.wide_block() * channels] += float(x * cf.pw);
+          node[(b.wide_block() + 1) * channels] += float(x * cf.pm);
+        }
       }
     }
 }
@@ -171,6 +183,7 @@ void drop_unmatched(FloatArray* v, int channels, Blocks b) {
       node[c] = 0.0f;
       if (b.spread) node[2 * channels + c] = 0.0f;
       if (b.pk) node[b.pk_block() * channels + c] = 0.0f;
+      if (b.wide) node[b.wide_block() * channels + c] = node[(b.wide_block() + 1) * channels + c] = 0.0f;
     }
   }
 }
@@ -238,6 +251,8 @@ struct BeamPhotons {
   void chord_to_light(const Vec3& q, Rgb* full, Rgb* reduced) const;
   // T_wide from q to the light: the map, or the chord.
   Rgb wide(const Vec3& q) const;
+  // T_light and T_wide from q to the light: the maps, or the chord.
+  void full_and_wide(const Vec3& q, Rgb* full, Rgb* reduced) const;
   // The straight model's spread 1 - mean cosine at q, 1 - exp(-tau (1 - chi_1)) for the peak depth tau =
   // ln(T_wide / T_light) (eq. D3 at l = 1), and T_wide there.
   Rgb straight_spread(const Vec3& q, Rgb* tw) const;
@@ -256,6 +271,13 @@ void BeamPhotons::chord_to_light(const Vec3& q, Rgb* full, Rgb* reduced) const {
                         : chord_full_and_reduced(ctx, q, -dir_w, inf, peak_fraction, full, reduced);
   NIMBUS_DCHECK(done);
   if (!done) *full = *reduced = Rgb(1.0);
+}
+
+void BeamPhotons::full_and_wide(const Vec3& q, Rgb* full, Rgb* reduced) const {
+  if (chord) return chord_to_light(q, full, reduced);
+  const TrilinearStencil st = T_wide.stencil(q);  // the pair's shared layout (build_pair)
+  *reduced = T_wide.lookup(st);
+  *full = T_full.lookup(st);
 }
 
 Rgb BeamPhotons::wide(const Vec3& q) const {
@@ -298,10 +320,14 @@ void BeamPhotons::sample(float* tally, const Vec3& q, const Vec3& w, double dl, 
   }
   const Rgb mid = *weight * half;
   *weight = mid * half;
-  Rgb tw;
+  Rgb tw, tf;  // T_wide and (for the wide factor) T_light at q
   const bool spread_s_wanted = blocks.spread && to != Columns::traced;
+  const bool wide_wanted = blocks.wide && to != Columns::straight;
   const Rgb spread_s = spread_s_wanted ? straight_spread(q, &tw) : Rgb(0.0);
-  if (!spread_s_wanted) tw = wide(q);
+  if (wide_wanted)
+    full_and_wide(q, &tf, &tw);
+  else if (!spread_s_wanted)
+    tw = wide(q);
   const double geo = point ? 1.0 / std::max(1e-300, dot(q - point->position, q - point->position)) : 1.0;
   const bool traced = to != Columns::straight;
   // 1 - the cosine between the travel direction and the straight one from the light.
@@ -309,13 +335,23 @@ void BeamPhotons::sample(float* tally, const Vec3& q, const Vec3& w, double dl, 
                             ? 0.0
                             : 1.0 - (point ? dot(w, normalize(q - point->position)) : dot(w, dir_w));
   // The peak-only light's last peak scatter towards the camera (the forward-peak term's angular factor).
-  const double pk = camera && traced ? splits[0]->peak(dot(w, normalize(*camera - q))) : 0.0;
+  CameraFactors cf;
+  Vec3 to_camera(0.0);
+  if (camera && traced) to_camera = normalize(*camera - q);
+  if (blocks.pk && traced) cf.pk = splits[0]->peak(dot(w, to_camera));
+  // The wide factor towards the camera: P_wide at the photon's own direction, and the straight model's,
+  // wide_eff at the straight beam's peak depth ln(T_wide / T_light) and the straight direction.
+  const double mu_s = wide_wanted ? dot(point ? normalize(q - point->position) : dir_w, to_camera) : 0.0;
+  if (wide_wanted) cf.pw = splits[0]->wide(dot(w, to_camera));
   const TrilinearStencil st = grid.stencil(q);
   for (int ch = 0; ch < channels; ++ch) {
     if ((!grey && ch != c) || !(tw[ch] > 1e-30)) continue;
     const double v = mid[ch] * dl / (tw[ch] * geo);
     NIMBUS_DCHECK(v >= 0.0 && std::isfinite(v));
-    splat(tally, channels, blocks, st, ch, v, spread, spread_s[ch], pk, to);
+    if (wide_wanted)
+      cf.pm = splits[0]->wide_eff(
+          tf[ch] > 1e-30 ? std::max(0.0, std::log(tw[ch] / tf[ch])) : PhaseSplit::kTauMax, mu_s);
+    splat(tally, channels, blocks, st, ch, v, spread, spread_s[ch], cf, to);
   }
 }
 
@@ -443,8 +479,10 @@ BeamGrid::BeamGrid(const SceneContext& ctx, const std::vector<const PhaseSplit*>
                    const std::vector<double>& peak_fraction, const std::vector<TransmittanceGrid>& full_maps,
                    const std::vector<TransmittanceGrid>& reduced_maps, const std::vector<int>& photons,
                    int resolution, uint64_t seed, bool spread, const Vec3* camera,
-                   const MajorantGrid* majorants, bool skip_idle, int smoothing)
-    : with_camera_(camera != nullptr), spread_(spread) {
+                   const MajorantGrid* majorants, bool skip_idle, int smoothing, BeamCameraTallies tallies)
+    : with_camera_(camera != nullptr && tallies.peak),
+      with_wide_(camera != nullptr && tallies.wide),
+      spread_(spread) {
   if (camera) camera_ = *camera;
   values_.resize(ctx.lights.size());
   const Bounds media_bounds = ctx.media.bounds();
@@ -456,7 +494,7 @@ BeamGrid::BeamGrid(const SceneContext& ctx, const std::vector<const PhaseSplit*>
   grid_ = node_grid_padded(media_bounds, resolution);
   const bool grey = grey_media(ctx);
   channels_ = grey && grey_lights(ctx) ? 1 : 3;
-  const Blocks blocks{.spread = spread, .pk = camera != nullptr};
+  const Blocks blocks{.spread = spread, .pk = with_camera_, .wide = with_wide_};
   stride_ = channels_ * blocks.count();
   const Vec3 centre = (media_bounds.lo + media_bounds.hi) * 0.5;
   // Photons cover the whole node grid (its padding included), so every node's estimate is complete.
@@ -506,19 +544,21 @@ BeamGrid::BeamGrid(const SceneContext& ctx, const std::vector<const PhaseSplit*>
 }
 
 bool BeamGrid::lookup(size_t light, const Vec3& p, const Rgb& T_light, const Rgb& T_wide, Rgb* factor,
-                      Rgb* mean_cosine, Rgb* peak_toward) const {
+                      Rgb* mean_cosine, Rgb* peak_toward, Rgb* wide_ratio) const {
   if (light >= values_.size() || values_[light].empty() || !grid_.bounds.contains(p)) return false;
-  return lookup(light, p, grid_.stencil(p), T_light, T_wide, factor, mean_cosine, peak_toward);
+  return lookup(light, p, grid_.stencil(p), T_light, T_wide, factor, mean_cosine, peak_toward, wide_ratio);
 }
 
 bool BeamGrid::lookup(size_t light, const Vec3& p, const TrilinearStencil& st, const Rgb& T_light,
-                      const Rgb& T_wide, Rgb* factor, Rgb* mean_cosine, Rgb* peak_toward) const {
+                      const Rgb& T_wide, Rgb* factor, Rgb* mean_cosine, Rgb* peak_toward,
+                      Rgb* wide_ratio) const {
   if (light >= values_.size() || values_[light].empty() || !grid_.bounds.contains(p)) return false;
   const FloatArray& v = values_[light];
   const int n = channels_;
-  const Blocks blocks{.spread = spread_, .pk = with_camera_};
+  const Blocks blocks{.spread = spread_, .pk = with_camera_, .wide = with_wide_};
   const bool spread = spread_ && mean_cosine, pk_wanted = with_camera_ && peak_toward;
-  Rgb r(0.0), straight(0.0), sp(0.0), sp_s(0.0), pk(0.0);
+  const bool wide_wanted = with_wide_ && wide_ratio;
+  Rgb r(0.0), straight(0.0), sp(0.0), sp_s(0.0), pk(0.0), pw(0.0), pm(0.0);
   for (int k = 0; k < 8; ++k)
     for (int c = 0; c < n; ++c) {
       const float* node = &v[st.node[k] * size_t(stride_) + c];
@@ -529,6 +569,10 @@ bool BeamGrid::lookup(size_t light, const Vec3& p, const TrilinearStencil& st, c
         sp_s[c] += st.weight[k] * node[3 * n];
       }
       if (pk_wanted) pk[c] += st.weight[k] * node[blocks.pk_block() * n];
+      if (wide_wanted) {
+        pw[c] += st.weight[k] * node[blocks.wide_block() * n];
+        pm[c] += st.weight[k] * node[(blocks.wide_block() + 1) * n];
+      }
     }
   // The straight model's spread at p itself: the control variate of the tallies' spread (eq. D9b).
   const Rgb model =
@@ -542,11 +586,13 @@ bool BeamGrid::lookup(size_t light, const Vec3& p, const TrilinearStencil& st, c
       (*mean_cosine)[c] = 1.0 - std::clamp(s, 0.0, 2.0);
     }
     if (peak_toward) (*peak_toward)[c] = r[c] > 0.0 ? pk[c] / r[c] : 0.0;
+    if (wide_ratio) (*wide_ratio)[c] = wide_wanted && pw[c] > 0.0 && pm[c] > 0.0 ? pw[c] / pm[c] : 1.0;
   }
   if (n == 1) {  // channel 0 stands for all three
     *factor = Rgb((*factor)[0]);
     if (mean_cosine) *mean_cosine = Rgb((*mean_cosine)[0]);
     if (peak_toward) *peak_toward = Rgb((*peak_toward)[0]);
+    if (wide_ratio) *wide_ratio = Rgb((*wide_ratio)[0]);
   }
   return true;
 }

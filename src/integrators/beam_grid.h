@@ -39,6 +39,13 @@
 
 namespace nimbus {
 
+// What a beam grid with a camera tallies towards it: the traced beam's P_peak (peak_toward_camera, eq. D15)
+// and its P_wide, with the straight model's wide factor at the same samples (wide_toward_camera).
+struct BeamCameraTallies {
+  bool peak = true;
+  bool wide = false;
+};
+
 class BeamGrid {
  public:
   // full_maps[l], reduced_maps[l]: light l's T_light and T_wide, a pair of one layout (build_pair; empty
@@ -53,20 +60,24 @@ class BeamGrid {
            const std::vector<double>& peak_fraction, const std::vector<TransmittanceGrid>& full_maps,
            const std::vector<TransmittanceGrid>& reduced_maps, const std::vector<int>& photons,
            int resolution, uint64_t seed, bool spread, const Vec3* camera = nullptr,
-           const MajorantGrid* majorants = nullptr, bool skip_idle = true, int smoothing = 0);
+           const MajorantGrid* majorants = nullptr, bool skip_idle = true, int smoothing = 0,
+           BeamCameraTallies tallies = {});
   // R for light `light` at p (trilinear between nodes) and, if mean_cosine is not null, the peak-only
   // light's mean cosine to the straight direction from the light, given the straight model's T_light and
   // T_wide at p (the spread's control variate; a grid without `spread`: the straight model's); false
   // (nothing written) outside the grid and for other lights.
   // With a camera, peak_toward (if not null) gets the traced beam's P_peak (medium 0's) towards the camera,
   // averaged over its directions: the angular factor of the forward peak alone (eq. D7's peak_eff).
+  // With the wide tallies, wide_ratio (if not null) gets the traced beam's P_wide towards the camera over
+  // the straight model's wide_eff(ln(T_wide / T_light), mu) at the same samples (1 where either is 0).
   bool lookup(size_t light, const Vec3& p, const Rgb& T_light, const Rgb& T_wide, Rgb* factor,
-              Rgb* mean_cosine, Rgb* peak_toward = nullptr) const;
+              Rgb* mean_cosine, Rgb* peak_toward = nullptr, Rgb* wide_ratio = nullptr) const;
   // The same from st, node_grid().stencil(p), found once for grids of the same layout (the scatter grid's).
   bool lookup(size_t light, const Vec3& p, const TrilinearStencil& st, const Rgb& T_light, const Rgb& T_wide,
-              Rgb* factor, Rgb* mean_cosine, Rgb* peak_toward = nullptr) const;
+              Rgb* factor, Rgb* mean_cosine, Rgb* peak_toward = nullptr, Rgb* wide_ratio = nullptr) const;
   const NodeGrid& node_grid() const { return grid_; }
   bool has_camera() const { return with_camera_; }
+  bool has_wide() const { return with_wide_; }
   // Floats per column of a node: 1 where grey media and grey lights make the three channels the same
   // numbers (channel 0 is kept and stands for all), else 3.
   int channels() const { return channels_; }
@@ -84,6 +95,7 @@ class BeamGrid {
   uint64_t rejection_failures_ = 0;
   double idle_share_ = 0.0;
   bool with_camera_;  // the nodes hold a column of P_peak towards camera_
+  bool with_wide_;    // the nodes hold columns of P_wide and the model's wide factor towards camera_
   bool spread_;       // the nodes hold the traced and the straight spread
   int channels_ = 3;  // floats per column
   int stride_ = 0;    // floats per node

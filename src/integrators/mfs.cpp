@@ -59,14 +59,7 @@ MfsIntegrator::MfsIntegrator(const SceneContext& context, MfsSettings settings, 
   const MajorantGrid* tracking = photon_majorants ? &*photon_majorants : nullptr;
   std::vector<const PhaseSplit*> splits;  // for the photon grids
   for (const auto& sp : splits_) splits.push_back(sp.get());
-  if (beam_on()) {
-    // peak_toward_camera: the beam's P_peak towards the camera tallied too (one medium only).
-    const Vec3 camera = ctx_.camera.origin();
-    const bool toward = s_.peak_toward_camera && ctx_.media.count() == 1;
-    beam_ = std::make_unique<BeamGrid>(
-        ctx_, splits, f_, full_maps_, reduced_maps_, beam_counts_, *s_.scatter_grid_resolution, seed,
-        s_.beam_spread == BeamSpread::traced, toward ? &camera : nullptr, tracking, true, s_.beam_smoothing);
-  }
+  if (beam_on()) build_beam(splits, tracking, seed);
   // Wide scatters 2 .. K from the scatter grid (for K = 1 only the environment's light).
   if (s_.large_angle_scatters != 0 &&
       (s_.large_angle_scatters != 1 || ctx_.has_environment || ctx_.media.emits())) {
@@ -312,8 +305,7 @@ MfsIntegrator::MediumRadiance MfsIntegrator::medium_radiance(int i, const Vec3& 
   const PhaseSplit& split = *splits_[i];
   const double f = f_[i];
   MediumRadiance out{Rgb(0.0), Rgb(0.0), Rgb(0.0)};
-  const bool tilted = !(d_s == d);
-  // peak_toward_camera's tally holds the light sent towards the camera: used on rays from it only.
+  // peak_ and wide_toward_camera's tallies hold the light sent towards the camera: used on rays from it only.
   const auto camera_ray = [&] {
     const Vec3 v = p - ctx_.camera.origin(), c = cross(v, d);
     return dot(v, d) > 0.0 && dot(c, c) <= 1e-12 * dot(v, v);
@@ -330,11 +322,12 @@ MfsIntegrator::MediumRadiance MfsIntegrator::medium_radiance(int i, const Vec3& 
         y.gradient_tilt > 0.0
             ? PhaseSplit::angle(
                   dot(gradient_tilted(d_s, ls.wi, cut_gradient_tilt(y, d_s, ls.wi, beam.T_wide)), ls.wi))
-        : tilted ? PhaseSplit::angle(dot(d_s, ls.wi))
-                 : a;
+        : !(d_s == d) ? PhaseSplit::angle(dot(d_s, ls.wi))
+                      : a;
+    const Rgb T_first = beam.wide && camera_ray() ? beam.T_wide * beam.wide_ratio : beam.T_wide;  // eq. D20
     if (s_.large_angle_scatters != 0)  // eq. D7, first term
       out.L += first_wide_scatter(ls.weight, f, split, a_s, y.tau_p, s_.light_blur ? beam.tau_ps : Rgb(0.0),
-                                  beam.T_wide);
+                                  T_first);
     if (s_.forward_light_path() && beam.toward && camera_ray())  // the traced beam's P_peak to the camera
       out.L_peak += ls.weight * f * beam.peak_toward * beam.T_wide;
     else if (s_.forward_light_path())  // eq. D7, second term: to the camera with T_full
@@ -378,6 +371,18 @@ LightBeam MfsIntegrator::environment_beam(int i, const Vec3& p, const Vec3& wi) 
                         s_.forward_light_path() && s_.path_lengthening);
 }
 
+void MfsIntegrator::build_beam(const std::vector<const PhaseSplit*>& splits, const MajorantGrid* tracking,
+                               uint64_t seed) {
+  // peak_toward_camera, wide_toward_camera: P_peak, P_wide towards the camera tallied too (one medium only).
+  const Vec3 camera = ctx_.camera.origin();
+  const bool one = ctx_.media.count() == 1;
+  const BeamCameraTallies tallies{.peak = s_.peak_toward_camera && one, .wide = s_.wide_toward_camera && one};
+  beam_ = std::make_unique<BeamGrid>(ctx_, splits, f_, full_maps_, reduced_maps_, beam_counts_,
+                                     *s_.scatter_grid_resolution, seed, s_.beam_spread == BeamSpread::traced,
+                                     tallies.peak || tallies.wide ? &camera : nullptr, tracking, true,
+                                     s_.beam_smoothing, tallies);
+}
+
 void MfsIntegrator::exact_light_transmittance(const Vec3& p, const LightSample& ls, Rgb* T_light,
                                               Rgb* T_wide) const {
   // One constant-density sphere or box: the chord to the light in closed form. The shadow maps'
@@ -404,15 +409,20 @@ LightBeam MfsIntegrator::light_beam(size_t l, int i, const Vec3& p, const LightS
     T_light = full_maps_[l].lookup(map_st);
     T_wide = s_.forward_light_path() ? reduced_maps_[l].lookup(map_st) : T_light;
   }
-  Rgb R(1.0), mean_cos(1.0), toward(0.0);
+  Rgb R(1.0), mean_cos(1.0), toward(0.0), wide_ratio(1.0);
   Rgb* spread = s_.beam_spread == BeamSpread::traced ? &mean_cos : nullptr;  // else the straight beam's
-  const bool traced = beam_ && (st ? beam_->lookup(l, p, *st, T_light, T_wide, &R, spread, &toward)
-                                   : beam_->lookup(l, p, T_light, T_wide, &R, spread, &toward));
+  const bool traced =
+      beam_ && (st ? beam_->lookup(l, p, *st, T_light, T_wide, &R, spread, &toward, &wide_ratio)
+                   : beam_->lookup(l, p, T_light, T_wide, &R, spread, &toward, &wide_ratio));
   LightBeam b = peak_only_beam(T_light, T_wide, traced, R, spread, splits_[i]->peak_moments(), theta2_[i],
                                s_.forward_light_path() && s_.path_lengthening);
   if (traced && beam_->has_camera()) {
     b.toward = true;
     b.peak_toward = toward;
+  }
+  if (traced && beam_->has_wide()) {
+    b.wide = true;
+    b.wide_ratio = wide_ratio;
   }
   return b;
 }

@@ -60,6 +60,7 @@
 // | `camera_shift`            | boolean                       | true      | in the bulk (both footprint points in a medium), the lights' first wide scatter read in the direction tilted towards each light by cov(offset, deflection) sigma_red: the correlation of the footprint's offset with its deflection along the beam's gradient (D17), the beam's growth cut at the medium's surface towards the light (D17b; with camera_tilt only) |
 // | `entry_loss`              | boolean                       | true      | where a footprint offset of a march step (with camera_tilt) lies outside the media before the entry of the line through it along the ray (the camera-bound paths displaced there left through the face the ray came in by, and no light beyond the ray's chord makes up for them), the scattered light of that half of the footprint is lost (D18) |
 // | `peak_toward_camera`      | boolean                       | false     | the forward peak alone takes its angular factor from the beam grid's photons (their P_peak towards the camera) instead of peak_eff at the beam's mean-cosine depth (one medium only) |
+// | `wide_toward_camera`      | boolean                       | false     | the lights' first wide scatter takes its angular factor from the beam grid's photons: P_wide from their directions towards the camera, over the straight beam's wide_eff at the same samples, multiplies the straight factor (D20; one medium only) |
 // | `exact_light_transmittance` | "auto" or boolean           | "auto"    | T_light and T_wide to directional and point lights without the shadow maps: the chord in closed form for one constant-density sphere or box, else a march ("auto": true for one constant-density sphere or box, else false; the header of a rendered image holds the choice) |
 // | `shadow_map_resolution`   | integer in [8, 1024]          | 64        | deep shadow map nodes along the longest axis |
 // | `edge_samples`            | "auto" or integer in [1, 64]  | "auto"    | samples per pixel sample at pixels a hard outline crosses (constant-density spheres and boxes, surfaces: scene/edges.h), a quarter of it (at least 1) beside them; 1: none; "auto": where the camera looks into a directional or point light's forward peak 64 up to 128 x 128 pixels, 64 / sqrt(pixels / 128^2) above, at least 16 (auto_edge_samples), else 16 (docs/benchmarks.md "Samples at the outlines") |
@@ -122,6 +123,7 @@ struct MfsSettings {
   bool entry_loss = true;
   bool grid_denoise = true;
   bool peak_toward_camera = false;
+  bool wide_toward_camera = false;
   std::optional<bool> exact_light_transmittance;  // nullopt: "auto" (resolved by MfsIntegrator)
   int shadow_map_resolution = 64;
   std::optional<int> edge_samples;  // nullopt: "auto" (resolved by MfsIntegrator: auto_edge_samples)
@@ -233,6 +235,8 @@ class MfsIntegrator final : public Integrator {
   // The shadow maps per light: the full and the reduced one (only the reduced one, for the beam grid,
   // with exact_light_transmittance).
   void build_maps();
+  // The beam grid over the photons' splits and tracking majorants (with the camera tallies its options ask for).
+  void build_beam(const std::vector<const PhaseSplit*>& splits, const MajorantGrid* tracking, uint64_t seed);
   // The beam from the environment image along wi (marched: full and reduced transmittance, no beam grid).
   LightBeam environment_beam(int i, const Vec3& p, const Vec3& wi) const;
   // The scatter grid's light, taking its last wide scatter at p towards the camera (eq. D12).

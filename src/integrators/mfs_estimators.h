@@ -124,6 +124,10 @@ struct LightBeam {
   // rays) where toward is set.
   bool toward = false;
   Rgb peak_toward{0.0};
+  // wide_toward_camera: the traced beam's P_wide towards the camera over the straight model's wide factor at
+  // the same samples (eq. D20), which multiplies the first wide scatter on camera rays where wide is set.
+  bool wide = false;
+  Rgb wide_ratio{1.0};
 };
 // From the shadow maps' T_light and T_wide, and from the beam grid where it covers y (traced: T_wide times
 // R, and with mean_cos the spread from the beam's mean cosine, eq. D9; without it, or not traced, the

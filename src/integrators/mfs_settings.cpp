@@ -52,6 +52,7 @@ MfsSettings mfs_settings_from_json(const nlohmann::json& options, const std::str
   s.entry_loss = o.boolean("entry_loss", s.entry_loss);
   s.grid_denoise = o.boolean("grid_denoise", s.grid_denoise);
   s.peak_toward_camera = o.boolean("peak_toward_camera", s.peak_toward_camera);
+  s.wide_toward_camera = o.boolean("wide_toward_camera", s.wide_toward_camera);
   if (bool b = false; o.keyword_or_boolean("exact_light_transmittance", "auto", &b))
     s.exact_light_transmittance = b;
   s.shadow_map_resolution = int(o.integer("shadow_map_resolution", 8, 1024, s.shadow_map_resolution));
@@ -91,6 +92,7 @@ nlohmann::json to_json(const MfsSettings& s) {
                       {"entry_loss", s.entry_loss},
                       {"grid_denoise", s.grid_denoise},
                       {"peak_toward_camera", s.peak_toward_camera},
+                      {"wide_toward_camera", s.wide_toward_camera},
                       {"shadow_map_resolution", s.shadow_map_resolution}};
   j["edge_samples"] = s.edge_samples ? nlohmann::json(*s.edge_samples) : nlohmann::json("auto");
   j["peak_fraction"] = s.peak_fraction ? nlohmann::json(*s.peak_fraction) : nlohmann::json("auto");

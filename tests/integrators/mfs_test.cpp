@@ -625,6 +625,69 @@ struct BeamInputs {
   std::vector<TransmittanceGrid> full, reduced;
 };
 
+// wide_toward_camera (eq. D20): the traced beam's P_wide towards the camera over the straight model's
+// wide_eff at the same samples. (a) In an optically thin sphere every photon flies undeflected along the
+// light, so the tally is P_wide at the angle between the light's travel and the camera over wide_eff at peak
+// depth ~0 (the same function, tabulated): 1 within 2 %; a sign slip in either direction reads P_wide at
+// another angle and misses by far more. (b) Beside a face that the light runs along, no photon comes from
+// beyond the face: the beam there leans out through it, towards a camera on that side, at angles where
+// P_wide is larger, so the factor exceeds 1 (by ~10 % a node inside the face), while in the bulk the straight
+// beam's spread is the traced one's (a broad beam) and the factor is 1 within the photons' noise.
+TEST(Mfs, BeamGridTalliesTheWideFactorTowardsTheCamera) {
+  const std::string light =
+      R"("lights": [{"type": "directional", "direction": [1, 0, 0], "irradiance": 1.0}])";
+  const Scene thin = test::scene_from_json("{" + test::camera_json(8, 8, 35.0, 4.0) + R"(,
+    "media": [{"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1}, "sigma_s": 0.01, "sigma_a": 0.0,
+               "phase": {"type": "hg", "g": 0.85}}], )" +
+                                           light + "}");
+  const SceneContext thin_ctx(thin);
+  MfsSettings ms = mfs_settings_from_json(nlohmann::json::object(), "test");
+  ms.large_angle_scatters = 1;
+  ms.wide_toward_camera = true;
+  const MfsIntegrator mfs(thin_ctx, ms);
+  ASSERT_NE(mfs.beam_grid(), nullptr);
+  ASSERT_TRUE(mfs.beam_grid()->has_wide());
+  EXPECT_FALSE(mfs.beam_grid()->has_camera());  // P_peak is not tallied
+  Rng rng(5, 0);
+  double worst = 0.0;
+  for (int i = 0; i < 100; ++i) {
+    const double x = 1.4 * rng.uniform() - 0.7;
+    const double y = 1.4 * rng.uniform() - 0.7;
+    const double z = 1.4 * rng.uniform() - 0.7;
+    Rgb R, ratio;
+    ASSERT_TRUE(mfs.beam_grid()->lookup(0, Vec3(x, y, z), Rgb(1.0), Rgb(1.0), &R, nullptr, nullptr, &ratio));
+    worst = std::max(worst, std::abs(ratio[0] - 1.0));
+    EXPECT_NEAR(ratio[0], 1.0, 0.02) << "at " << x << " " << y << " " << z;
+  }
+  std::printf("wide factor towards the camera, thin sphere: worst |ratio - 1| %.4f\n", worst);
+  const Scene box = test::scene_from_json("{" + test::camera_json(8, 8, 35.0, 6.0) + R"(,
+    "media": [{"shape": {"type": "box", "min": [-1, -1, -1], "max": [1, 1, 1]}, "sigma_s": 4.0, "sigma_a": 0.02,
+               "phase": {"type": "hg", "g": 0.9}}], )" +
+                                          light + "}");
+  const SceneContext ctx(box);
+  const BeamInputs inputs(ctx);
+  const Vec3 cam(0.0, -6.0, 0.0);
+  const BeamGrid g = inputs.grid(ctx, std::vector<int>{1 << 17}, 32, 3, false, &cam, nullptr, true, 0,
+                                 BeamCameraTallies{.peak = false, .wide = true});
+  // The mean factor over a 5 x 5 patch of x (depths 0.6 to 1.4 from the lit face) and z, at y.
+  const auto mean_ratio = [&](double y) {
+    double sum = 0.0;
+    for (int i = 0; i < 5; ++i)
+      for (int k = 0; k < 5; ++k) {
+        const Vec3 p(-0.4 + 0.2 * i, y, -0.4 + 0.2 * k);
+        Rgb R, ratio;
+        EXPECT_TRUE(g.lookup(0, p, inputs.full[0].lookup(p), inputs.reduced[0].lookup(p), &R, nullptr,
+                             nullptr, &ratio));
+        sum += ratio[0] / 25.0;
+      }
+    return sum;
+  };
+  const double face = mean_ratio(-0.935), bulk = mean_ratio(0.0);
+  std::printf("wide factor towards the camera, box: a node inside the face %.4f, bulk %.4f\n", face, bulk);
+  EXPECT_NEAR(bulk, 1.0, 0.03);
+  EXPECT_GT(face, 1.05);
+}
+
 // The beam grid skips its deposits in cells with no medium in them or next to them (idle cells: the gap
 // between two spheres). Wherever there is a medium, R, the mean cosine and P_peak towards the camera must
 // be bit for bit those of the grid that deposits everywhere (a lookup reads only its cell's nodes); in the

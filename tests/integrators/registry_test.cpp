@@ -81,6 +81,7 @@ TEST(Registry, SettingsRoundTripThroughJson) {
                                               {"camera_shift", false},
                                               {"entry_loss", false},
                                               {"peak_toward_camera", true},
+                                              {"wide_toward_camera", true},
                                               {"exact_light_transmittance", true},
                                               {"shadow_map_resolution", 32}});
   expect_round_trip(&mfs_settings_from_json, {{"peak_fraction", "auto"},
@@ -106,7 +107,8 @@ TEST(Registry, DefaultsAreWrittenOut) {
   EXPECT_EQ(mfs["beam_smoothing"], 2);
   EXPECT_EQ(mfs["grid_denoise"], true);
   EXPECT_EQ(mfs["camera_fluence"], false);
-  EXPECT_EQ(mfs.size(), 29u);  // every option of the table in mfs.h
+  EXPECT_EQ(mfs["wide_toward_camera"], false);
+  EXPECT_EQ(mfs.size(), 30u);  // every option of the table in mfs.h
 }
 
 TEST(Registry, UnknownFieldsAndNamesAreErrors) {
