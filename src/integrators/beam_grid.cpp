@@ -253,9 +253,6 @@ struct BeamPhotons {
   Rgb wide(const Vec3& q) const;
   // T_light and T_wide from q to the light: the maps, or the chord.
   void full_and_wide(const Vec3& q, Rgb* full, Rgb* reduced) const;
-  // The straight model's spread 1 - mean cosine at q, 1 - exp(-tau (1 - chi_1)) for the peak depth tau =
-  // ln(T_wide / T_light) (eq. D3 at l = 1), and T_wide there.
-  Rgb straight_spread(const Vec3& q, Rgb* tw) const;
   void trace(size_t j, Rng& rng, PhotonBatch& batch) const;
   void sample(float* tally, const Vec3& q, const Vec3& w, double dl, Rgb* weight, int c, Columns to) const;
   Rgb deposit(float* tally, const Vec3& x, const Vec3& w, double t_end, Rgb weight, int c) const;
@@ -287,19 +284,6 @@ Rgb BeamPhotons::wide(const Vec3& q) const {
   return reduced;
 }
 
-Rgb BeamPhotons::straight_spread(const Vec3& q, Rgb* tw) const {
-  Rgb full, reduced;
-  if (chord) {
-    chord_to_light(q, &full, &reduced);
-  } else {
-    const TrilinearStencil st = T_wide.stencil(q);  // the pair's shared layout (build_pair)
-    reduced = T_wide.lookup(st);
-    full = T_full.lookup(st);
-  }
-  *tw = reduced;
-  return Rgb(1.0) - straight_mean_cosine(full, reduced, one_minus_chi1);
-}
-
 // One deposit sample at q (the midpoint of a step of length dl of the flight along w): the weight loses
 // exp(-sigma_loss dl) over the step and the midpoint's weight, divided by the straight-line model phi_0
 // T_wide at q, goes to the columns `to`. Channel c only unless grey.
@@ -320,14 +304,16 @@ void BeamPhotons::sample(float* tally, const Vec3& q, const Vec3& w, double dl, 
   }
   const Rgb mid = *weight * half;
   *weight = mid * half;
-  Rgb tw, tf;  // T_wide and (for the wide factor) T_light at q
+  Rgb tw, tf;  // T_wide and (for the straight spread or the wide factor) T_light at q
   const bool spread_s_wanted = blocks.spread && to != Columns::traced;
   const bool wide_wanted = blocks.wide && to != Columns::straight;
-  const Rgb spread_s = spread_s_wanted ? straight_spread(q, &tw) : Rgb(0.0);
-  if (wide_wanted)
+  if (spread_s_wanted || wide_wanted)
     full_and_wide(q, &tf, &tw);
-  else if (!spread_s_wanted)
+  else
     tw = wide(q);
+  // The straight model's spread 1 - mean cosine at q, 1 - exp(-tau (1 - chi_1)) for the peak depth tau =
+  // ln(T_wide / T_light) (eq. D3 at l = 1).
+  const Rgb spread_s = spread_s_wanted ? Rgb(1.0) - straight_mean_cosine(tf, tw, one_minus_chi1) : Rgb(0.0);
   const double geo = point ? 1.0 / std::max(1e-300, dot(q - point->position, q - point->position)) : 1.0;
   const bool traced = to != Columns::straight;
   // 1 - the cosine between the travel direction and the straight one from the light.
