@@ -556,13 +556,20 @@ TEST(Mfs, ExactLightTransmittanceAtABacklitRim) {
   EXPECT_GT(worst_map, 2.0 * worst_exact);  // the option is read, and it is what fixes the rim
 }
 
+// An optically thin unit sphere (sigma_s 0.01, HG 0.85) seen from 4 units, lit by a sun travelling along
+// `direction` (a JSON array): its peak-only beam is the light's own direction.
+Scene thin_sphere(const std::string& direction) {
+  return test::scene_from_json("{" + test::camera_json(8, 8, 35.0, 4.0) + R"(,
+    "media": [{"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1}, "sigma_s": 0.01, "sigma_a": 0.0,
+               "phase": {"type": "hg", "g": 0.85}}],
+    "lights": [{"type": "directional", "direction": )" +
+                               direction + R"(, "irradiance": 1.0}]})");
+}
+
 // peak_toward_camera: in an optically thin sphere the peak-only beam is the light's own direction, so the
 // traced P_peak towards the camera is P_peak at the angle between the light's travel and the camera.
 TEST(Mfs, BeamGridTalliesThePeakTowardsTheCamera) {
-  const Scene scene = test::scene_from_json("{" + test::camera_json(8, 8, 35.0, 4.0) + R"(,
-    "media": [{"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1}, "sigma_s": 0.01, "sigma_a": 0.0,
-               "phase": {"type": "hg", "g": 0.85}}],
-    "lights": [{"type": "directional", "direction": [0.2, -1, 0.25], "irradiance": 1.0}]})");
+  const Scene scene = thin_sphere("[0.2, -1, 0.25]");
   const SceneContext ctx(scene);
   MfsSettings ms = mfs_settings_from_json(nlohmann::json::object(), "test");
   ms.large_angle_scatters = 0;
@@ -634,12 +641,7 @@ struct BeamInputs {
 // P_wide is larger, so the factor exceeds 1 (by ~10 % a node inside the face), while in the bulk the straight
 // beam's spread is the traced one's (a broad beam) and the factor is 1 within the photons' noise.
 TEST(Mfs, BeamGridTalliesTheWideFactorTowardsTheCamera) {
-  const std::string light =
-      R"("lights": [{"type": "directional", "direction": [1, 0, 0], "irradiance": 1.0}])";
-  const Scene thin = test::scene_from_json("{" + test::camera_json(8, 8, 35.0, 4.0) + R"(,
-    "media": [{"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1}, "sigma_s": 0.01, "sigma_a": 0.0,
-               "phase": {"type": "hg", "g": 0.85}}], )" +
-                                           light + "}");
+  const Scene thin = thin_sphere("[1, 0, 0]");
   const SceneContext thin_ctx(thin);
   MfsSettings ms = mfs_settings_from_json(nlohmann::json::object(), "test");
   ms.large_angle_scatters = 1;
@@ -662,8 +664,8 @@ TEST(Mfs, BeamGridTalliesTheWideFactorTowardsTheCamera) {
   std::printf("wide factor towards the camera, thin sphere: worst |ratio - 1| %.4f\n", worst);
   const Scene box = test::scene_from_json("{" + test::camera_json(8, 8, 35.0, 6.0) + R"(,
     "media": [{"shape": {"type": "box", "min": [-1, -1, -1], "max": [1, 1, 1]}, "sigma_s": 4.0, "sigma_a": 0.02,
-               "phase": {"type": "hg", "g": 0.9}}], )" +
-                                          light + "}");
+               "phase": {"type": "hg", "g": 0.9}}],
+    "lights": [{"type": "directional", "direction": [1, 0, 0], "irradiance": 1.0}]})");
   const SceneContext ctx(box);
   const BeamInputs inputs(ctx);
   const Vec3 cam(0.0, -6.0, 0.0);
