@@ -181,8 +181,10 @@ int auto_scatter_grid_resolution(const SceneContext& ctx) {
 // (docs/benchmarks.md, "Photons by image size"): 4 x 2^18 gives 0.70x error^2 x CPU on the Disney cloud and 0.56x on the
 // front-lit r = 10 sphere against 2^18. The full image's pixels, not the spp or a region's: a resumed,
 // cropped or sample-range render traces the same photons as the render in one go. The scatter grid then
-// raises this to 2^18 times a factor of its pilot's collisions per photon where that is more
-// (ScatterGridSettings::adaptive_photons).
+// multiplies this by a factor of its pilot's collisions per photon C, clamp(sqrt(3.4 / C), 1, 4)
+// (ScatterGridSettings::adaptive_photons): a photon's cost c grows with C, and on thin media the grid's
+// noise a is most of the error. The two factors of N multiply (docs/benchmarks.md, "Photons by collisions
+// and image size together").
 constexpr int kAutoPhotons = 1 << 18;
 int auto_photons(const PinholeCamera& camera) {
   const double n = double(kAutoPhotons) * pixel_scale(camera);
@@ -260,7 +262,7 @@ ScatterGridSettings scatter_grid_settings(const MfsSettings& s, bool adaptive, u
                                           const MajorantGrid* tracking) {
   ScatterGridSettings grid;
   grid.photons = *s.photons;
-  grid.adaptive_photons = adaptive ? kAutoPhotons : 0;
+  grid.adaptive_photons = adaptive ? grid.photons : 0;  // the image size's count, times the pilot's factor
   grid.resolution = *s.scatter_grid_resolution;
   grid.max_wide_scatters = s.large_angle_scatters.value_or(0);
   grid.exact_transport = s.photon_transport == PhotonTransport::exact;

@@ -630,14 +630,15 @@ std::vector<uint8_t> live_nodes(const NodeGrid& grid, const MajorantGrid& majora
 // grid keeps settings.photons. On the validation suite (128 x 128, `mfs` 1 spp) error^2 x CPU is least
 // at about 2^18 photons on the optically thick spheres, the box and the Disney cloud (3.4 to 4.4
 // collisions per photon), 2^19 on the r = 2 sphere (0.89) and 2^20 on the r = 1 sphere (0.44)
-// (docs/benchmarks.md, "Photons by collisions").
+// (docs/benchmarks.md, "Photons by collisions"). `mfs` scales its image size's count by the same factor.
 constexpr int kPilotPhotons = 2048;
 constexpr double kDenseCollisions = 3.4;
 constexpr double kMaxPhotonFactor = 4.0;
 
 // Whether a pilot could change the count: not where settings.photons is already the most it could give.
 bool wants_pilot(const ScatterGridSettings& s) {
-  return s.adaptive_photons > 0 && double(s.photons) < kMaxPhotonFactor * double(s.adaptive_photons);
+  return s.adaptive_photons > 0 && double(s.photons) < kMaxPhotonFactor * double(s.adaptive_photons) &&
+         s.photons < (1 << 26);
 }
 
 void ScatterPhotons::split(int photons) {

@@ -55,9 +55,9 @@ struct ScatterGridSettings {
   // photons' real collisions per photon C, and the grid traces
   // max(photons, adaptive_photons x clamp(sqrt(kDenseCollisions / C), 1, 4)). A photon's cost grows with C
   // while on thin media the grid's noise is most of the error, so thin media buy their error with more
-  // photons (docs/benchmarks.md, "Photons by collisions"). `mfs`'s "auto" photons: 2^18, its count at
-  // 128 x 128 (the larger images' counts already buy that noise down); 0 for a count given. No pilot
-  // where photons >= 4 x adaptive_photons (it could not raise the count: `mfs` from 512 x 512 pixels).
+  // photons (docs/benchmarks.md, "Photons by collisions"). `mfs`'s "auto" photons: its image size's count
+  // (auto_photons), so the two factors multiply; 0 for a count given. No pilot where photons >= 4 x
+  // adaptive_photons or 2^26 (it could not raise the count).
   int adaptive_photons = 0;
   // Chromatic media: one photon pass per channel, each with that channel's coefficients (true), or one
   // pass of hero-channel photons carrying all three (false; scatter_grid.cpp's HeroWalk). Grey media

@@ -107,18 +107,22 @@ TEST(RenderSettings, AutoGridResolutionFollowsTheImageAndTheOpticalSize) {
 }
 
 // "auto" photons: 2^18 up to 128 x 128 pixels, then 2^18 sqrt(pixels / 128^2), from the whole image's pixels,
-// or 2^18 times the factor of the medium's collisions per photon where that is more (the same pilot at
-// every image size): a crop of a 256 x 256 image traces max(2^19, the 8 x 6 image's), as the whole
-// 256 x 256 image would.
+// times the factor of the medium's collisions per photon (the same pilot at every image size): a crop of a
+// 256 x 256 image traces twice the 8 x 6 image's count, as the whole 256 x 256 image would. A thin sphere's
+// factor is the most, 4: 2^20 at 8 x 6 and 2^21 for the crop (a rule taking the larger of the two factors
+// instead of their product would stay at 2^20).
 TEST(RenderSettings, AutoPhotonsFollowTheWholeImagesPixels) {
   const std::string mfs = R"({"type": "mfs", "spp": 1, "beam_photons": 1024, "scatter_grid_resolution": 8})";
-  const int small = render(settings_sphere_scene(mfs)).settings["photons"];
-  EXPECT_GE(small, 1 << 18);
-  EXPECT_LE(small, 1 << 20);
   RenderOptions o;
   o.region = Region{100, 100, 102, 101};
-  const RenderResult crop = render(settings_sphere_scene(mfs, 256, 256), o);
-  EXPECT_EQ(crop.settings["photons"], std::max(1 << 19, small));
+  for (const double sigma_s : {3.0, 0.3}) {
+    const int small = render(settings_sphere_scene(mfs, 8, 6, sigma_s)).settings["photons"];
+    EXPECT_GE(small, 1 << 18);
+    EXPECT_LE(small, 1 << 20);
+    const int crop = render(settings_sphere_scene(mfs, 256, 256, sigma_s), o).settings["photons"];
+    EXPECT_NEAR(crop, 2.0 * small, 1.0) << sigma_s;
+    if (sigma_s < 1.0) EXPECT_EQ(crop, 1 << 21);
+  }
 }
 
 // "auto" photons by the pilot's collisions per photon: an optically thick sphere (radius 10 optical
