@@ -43,12 +43,10 @@ MfsIntegrator::MfsIntegrator(const SceneContext& context, MfsSettings settings, 
   double cut_angle = 0.0;  // the widest peak's, for "auto" beam photons
   for (const auto& sp : splits_)
     if (sp->f() > 0.0) cut_angle = std::max(cut_angle, sp->cut_angle());
+  const bool auto_beam = !s_.beam_photons;
   beam_counts_ = s_.beam_photons ? std::vector<int>(ctx_.lights.size(), *s_.beam_photons)
                                  : auto_beam_photons(ctx_, cut_angle);
   if (!s_.edge_samples) s_.edge_samples = auto_edge_samples(ctx_, cut_angle);
-  if (!beam_counts_.empty() &&
-      std::all_of(beam_counts_.begin(), beam_counts_.end(), [&](int n) { return n == beam_counts_[0]; }))
-    s_.beam_photons = beam_counts_[0];  // the header's settings: one count for every light, or "auto"
   // The light's chord in closed form where there is one (the maps' interpolation errs at sharp rims).
   if (!s_.exact_light_transmittance)
     s_.exact_light_transmittance = ctx_.analytic.active() && ctx_.media.count() == 1;
@@ -59,14 +57,20 @@ MfsIntegrator::MfsIntegrator(const SceneContext& context, MfsSettings settings, 
   const MajorantGrid* tracking = photon_majorants ? &*photon_majorants : nullptr;
   std::vector<const PhaseSplit*> splits;  // for the photon grids
   for (const auto& sp : splits_) splits.push_back(sp.get());
-  if (beam_on()) build_beam(splits, tracking, seed);
   // Wide scatters 2 .. K from the scatter grid (for K = 1 only the environment's light).
   if (s_.large_angle_scatters != 0 &&
       (s_.large_angle_scatters != 1 || ctx_.has_environment || ctx_.media.emits())) {
     grid_ = std::make_unique<ScatterGrid>(ctx_, splits, f_,
                                           scatter_grid_settings(s_, !settings.photons, seed, tracking));
     s_.photons = grid_->photons();
+    // Thin media take more beam photons (auto_beam_photons); the tracking grid above counted the fewer.
+    if (auto_beam && grid_->collisions_per_photon())
+      beam_counts_ = auto_beam_photons(ctx_, cut_angle, grid_->collisions_per_photon());
   }
+  if (!beam_counts_.empty() &&
+      std::all_of(beam_counts_.begin(), beam_counts_.end(), [&](int n) { return n == beam_counts_[0]; }))
+    s_.beam_photons = beam_counts_[0];  // the header's settings: one count for every light, or "auto"
+  if (beam_on()) build_beam(splits, tracking, seed);
   // The pieces' march (constant-density shapes) steps at most one node spacing of the photon grids: the
   // light they hold varies on that scale (the majorant grid's cells, of about the same size, bound the
   // steps elsewhere). Without grids, 1/32 of the media's extent, as those cells.

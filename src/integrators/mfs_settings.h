@@ -18,7 +18,8 @@ int auto_scatter_grid_resolution(const SceneContext& ctx);
 // "auto" scatter-grid photons from the whole image's pixels.
 int auto_photons(const PinholeCamera& camera);
 // "auto" beam-grid photons per light, given the widest peak's cut angle [rad].
-std::vector<int> auto_beam_photons(const SceneContext& ctx, double cut_angle);
+std::vector<int> auto_beam_photons(const SceneContext& ctx, double cut_angle,
+                                   std::optional<double> collisions = std::nullopt);
 // "auto" edge samples (MfsSettings::edge_samples), given the widest peak's cut angle [rad].
 int auto_edge_samples(const SceneContext& ctx, double cut_angle);
 // The scatter grid's settings from mfs's (photons resolved; adaptive: they were "auto").

@@ -762,7 +762,10 @@ void ScatterGrid::trace(const SceneContext& ctx, const std::vector<const PhaseSp
   size_t rgb_size = 0;
   const size_t tally_size =
       assign_blocks(ctx, grey, lights, sources, grid_.size(), coeffs_, &photons.blocks, &rgb_size);
-  if (wants_pilot(s)) photons_ = adaptive_photon_count(s, pilot_collisions(photons, tally_size));
+  if (wants_pilot(s)) {
+    collisions_per_photon_ = pilot_collisions(photons, tally_size);
+    photons_ = adaptive_photon_count(s, *collisions_per_photon_);
+  }
   photons.split(photons_);
   const size_t total = size_t(passes) * photons.first.back();
   // Every source of one colour (grey media lit by lights of one tint): one channel per node, the tint

@@ -38,6 +38,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "core/node_grid.h"
@@ -131,6 +132,8 @@ class ScatterGrid {
   uint64_t rejection_failures() const { return rejection_failures_; }
   // The photons traced per pass (settings.photons, or what adaptive_photons made of it).
   int photons() const { return photons_; }
+  // The pilot's real collisions per photon (adaptive_photons), if it ran.
+  std::optional<double> collisions_per_photon() const { return collisions_per_photon_; }
 
   size_t memory_bytes() const {
     size_t bytes = values_.size() * sizeof(float);
@@ -142,6 +145,7 @@ class ScatterGrid {
   NodeGrid grid_;  // the media's bounds padded by one spacing (node_grid_padded)
   int bands_ = 3, coeffs_ = 9;
   int photons_ = 0;
+  std::optional<double> collisions_per_photon_;
   uint64_t rejection_failures_ = 0;
   // Channels per node: 1 where every source's photons carry one colour (tint_, max channel 1; grey
   // media lit by lights of one tint), else 3.

@@ -140,6 +140,27 @@ TEST(RenderSettings, AutoPhotonsFollowTheMediumsCollisions) {
   EXPECT_EQ(render(settings_sphere_scene(given, 4, 3, 0.3)).settings["photons"], 5000);
 }
 
+// "auto" beam photons in thin media (the scatter grid pilot's collisions per photon below 1.7): 2^15
+// sqrt(pixels / 128^2) for every directional or point light, seen from the side too. A side-lit sphere of
+// optical radius 0.3 traces 2^16 in a crop of a 256 x 256 image and 2^15 at 8 x 6; one of radius 10 (~4
+// collisions per photon) 2^15; with the scatter grid's photons given (no pilot) 2^15.
+TEST(RenderSettings, AutoBeamPhotonsFollowThePixelsInThinMedia) {
+  const auto scene = [](double sigma_s, int size, const std::string& photons) {
+    return test::scene_from_json("{" + test::camera_json(size, size) + R"(,
+      "media": [{"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1}, "sigma_s": )" +
+                                 std::to_string(sigma_s) + R"(, "phase": {"type": "hg", "g": 0.8}}],
+      "lights": [{"type": "directional", "direction": [-1, 0.3, 0.2], "irradiance": 1.0}],
+      "integrator": {"type": "mfs", "spp": 1, "photons": )" +
+                                 photons + R"(, "scatter_grid_resolution": 8}})");
+  };
+  RenderOptions crop;
+  crop.region = Region{128, 128, 129, 129};
+  EXPECT_EQ(render(scene(0.3, 256, "\"auto\""), crop).settings["beam_photons"], 1 << 16);
+  EXPECT_EQ(render(scene(0.3, 8, "\"auto\"")).settings["beam_photons"], 1 << 15);
+  EXPECT_EQ(render(scene(10.0, 256, "\"auto\""), crop).settings["beam_photons"], 1 << 15);
+  EXPECT_EQ(render(scene(0.3, 256, "4096"), crop).settings["beam_photons"], 1 << 15);
+}
+
 // "auto" beam photons: 2^15 per light, and 2^15 sqrt(pixels / 128^2) for a light whose forward peak the
 // camera looks into (its light travels towards the camera within the peak's cut angle, about 37 degrees
 // for HG 0.8, plus the media's size on the image): a crop of a 256 x 256 image of a backlit sphere
