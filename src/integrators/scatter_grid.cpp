@@ -681,6 +681,13 @@ bool exact_pieces(const SceneContext& ctx, const ScatterGridSettings& s) {
   return max_component(m.sigma_s) > 0.0 && sigma_t.x == sigma_t.y && sigma_t.y == sigma_t.z;
 }
 
+// Whether some medium scatters.
+bool any_scatters(const SceneMedia& media) {
+  for (int i = 0; i < media.count(); ++i)
+    if (max_component(media.medium(i).sigma_s) > 0.0) return true;
+  return false;
+}
+
 // The photons' batches summed and divided by the node volume (fluence and flux); with s.denoise, denoised
 // (grid_denoise.h) by the batches' shares of each channel's l = 0 coefficient.
 FloatArray sum_batches(const SceneContext& ctx, const ScatterGridSettings& s, const NodeGrid& grid,
@@ -726,10 +733,7 @@ void ScatterGrid::trace(const SceneContext& ctx, const std::vector<const PhaseSp
   const size_t lights = s.max_wide_scatters == 1 ? 0 : ctx.lights.size();  // K = 1: environment only
   // The media's emission is one more source, with its share of the photons (emit_from_media).
   // (Only where a medium scatters does the grid's light reach the camera.)
-  bool scatters = false;
-  for (int i = 0; i < ctx.media.count(); ++i)
-    scatters = scatters || max_component(ctx.media.medium(i).sigma_s) > 0.0;
-  const EmissionSampler emission = scatters ? EmissionSampler(ctx.media) : EmissionSampler();
+  const EmissionSampler emission = any_scatters(ctx.media) ? EmissionSampler(ctx.media) : EmissionSampler();
   const size_t sources = lights + (ctx.has_environment ? 1 : 0) + (emission.active() ? 1 : 0);
   if (sources == 0 || s.photons <= 0) return;
   const Bounds media_bounds = ctx.media.bounds();
