@@ -94,6 +94,7 @@ struct TallyView {
 struct PhotonBatch {
   TallyView tally;                  // the grid's per-node sums, laid out as the grid wants (zero at start)
   double collisions = 0.0;          // real collisions so far (the work budget's measure)
+  double null_collisions = 0.0;     // tentative collisions that were not real (the scatter grid counts them)
   uint64_t rejection_failures = 0;  // scatters whose direction sample_by_rejection could not draw
 };
 

@@ -387,7 +387,9 @@ void ScatterPhotons::trace(size_t j, Rng& rng, PhotonBatch& batch) const {
         // Over one grey constant-density shape's exact piece every tentative collision is real (sigma =
         // maj): the uniform is drawn as for any other, the density is not looked up (exact_pieces).
         const double sigma = exact_pieces ? maj : extinction(p)[c];
-        return rng.uniform() * maj < sigma;
+        const bool real = rng.uniform() * maj < sigma;
+        batch.null_collisions += real ? 0.0 : 1.0;
+        return real;
       },
       [&](const Vec3& x, const Vec3& w, double t_end) {
         if (order >= first_order)
@@ -509,6 +511,7 @@ void ScatterPhotons::trace_hero(const Photon& ph, int hero, const Rgb& share, co
         walk.sigma = extinction(p);
         NIMBUS_DCHECK(max_component(walk.sigma) <= maj * (1.0 + 1e-9) && min_component(walk.sigma) >= 0.0);
         if (rng.uniform() * maj < walk.sigma[walk.c]) return true;
+        batch.null_collisions += 1.0;
         deposit(dir, (p - seg).length());
         seg = p;
         const Rgb null_density(std::max(0.0, maj - walk.sigma.x), std::max(0.0, maj - walk.sigma.y),
@@ -631,6 +634,11 @@ std::vector<uint8_t> live_nodes(const NodeGrid& grid, const MajorantGrid& majora
 // at about 2^18 photons on the optically thick spheres, the box and the Disney cloud (3.4 to 4.4
 // collisions per photon), 2^19 on the r = 2 sphere (0.89) and 2^20 on the r = 1 sphere (0.44)
 // (docs/benchmarks.md, "Photons by collisions"). `mfs` scales its image size's count by the same factor.
+// The collisions counted are the tracking's work: the real ones and the null ones (none over the exact
+// pieces of constant-density shapes). A photon in a heterogeneous medium meets many null collisions, and
+// it is they that make it dear: the thin Disney cloud (0.82 real collisions per photon) took 2.04 x 2^18
+// photons by its real collisions alone, which cost more than they bought (error^2 x CPU 0.79x with 2^18 at
+// 128 x 128, 1.20x with 2.2 M against 2^20 at 512 x 512; docs/benchmarks.md, "Beam photons in thin media").
 constexpr int kPilotPhotons = 2048;
 constexpr double kDenseCollisions = 3.4;
 constexpr double kMaxPhotonFactor = 4.0;
@@ -646,8 +654,8 @@ void ScatterPhotons::split(int photons) {
   if (!ctx.surfaces.empty()) surface = surface_emission(ctx, centre, radius);
 }
 
-// Real collisions per photon of kPilotPhotons photons of a pass (photons.first is left split for them),
-// traced serially on streams of their own into a tally that is dropped.
+// Real and null collisions per photon of kPilotPhotons photons of a pass (photons.first is left split for
+// them), traced serially on streams of their own into a tally that is dropped.
 double pilot_collisions(ScatterPhotons& photons, size_t tally_size) {
   photons.split(kPilotPhotons);
   ZeroedFloats tally(tally_size);
@@ -658,7 +666,7 @@ double pilot_collisions(ScatterPhotons& photons, size_t tally_size) {
     Rng rng(photons.s.seed ^ 0x70696c6f74ull, j);
     photons.trace(j, rng, batch);
   }
-  return batch.collisions / double(n);
+  return (batch.collisions + batch.null_collisions) / double(n);
 }
 
 // max(s.photons, s.adaptive_photons x clamp(sqrt(kDenseCollisions / collisions), 1, kMaxPhotonFactor)).

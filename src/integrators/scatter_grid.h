@@ -53,7 +53,7 @@ namespace nimbus {
 struct ScatterGridSettings {
   int photons = 1 << 18;  // per pass, shared among the lights (see power_share)
   // More photons where they are cheap: when > 0, a pilot of kPilotPhotons (scatter_grid.cpp) counts the
-  // photons' real collisions per photon C, and the grid traces
+  // photons' collisions per photon C (real and null: the tracking's work), and the grid traces
   // max(photons, adaptive_photons x clamp(sqrt(kDenseCollisions / C), 1, 4)). A photon's cost grows with C
   // while on thin media the grid's noise is most of the error, so thin media buy their error with more
   // photons (docs/benchmarks.md, "Photons by collisions"). `mfs`'s "auto" photons: its image size's count
@@ -132,7 +132,7 @@ class ScatterGrid {
   uint64_t rejection_failures() const { return rejection_failures_; }
   // The photons traced per pass (settings.photons, or what adaptive_photons made of it).
   int photons() const { return photons_; }
-  // The pilot's real collisions per photon (adaptive_photons), if it ran.
+  // The pilot's real and null collisions per photon (adaptive_photons), if it ran.
   std::optional<double> collisions_per_photon() const { return collisions_per_photon_; }
 
   size_t memory_bytes() const {

@@ -291,5 +291,32 @@ TEST(ScatterGrid, OneColourOfLightKeepsOneChannel) {
   EXPECT_GT(lit, 100);
 }
 
+// The photon count's pilot (adaptive_photons) counts the tracking's work, null collisions with the real ones:
+// a thin sphere's photons tracked over its exact piece meet real collisions only; over a majorant grid of
+// 2 x 2 x 2 cells, whose majorant fills the sphere's bounding cube, they meet about as many null ones in the
+// cube's corners (the cube holds 1.9 x the sphere's volume) for the same real ones. So the pilot counts more
+// collisions per photon there and the grid traces fewer photons.
+TEST(ScatterGrid, PilotCountsNullCollisionsAsWork) {
+  const Scene scene = test::scene_from_json("{" + test::camera_json(8, 8, 40.0) + R"(,
+    "media": [{"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1}, "sigma_s": 0.3, "sigma_a": 0.01,
+               "phase": {"type": "hg", "g": 0.8}}],
+    "lights": [{"type": "directional", "direction": [-1, 0.3, 0.2], "irradiance": 3.0}]})");
+  const SceneContext pieces(scene);
+  SceneContext cells(scene);
+  cells.analytic = AnalyticMedia();
+  cells.majorants = MajorantGrid(cells.media, 2);
+  const Phase& phase = scene.media.front().phase;
+  const PhaseSplit split(phase, auto_peak_fraction(phase));
+  ScatterGridSettings s;
+  s.photons = s.adaptive_photons = 4096;
+  s.resolution = 8;
+  const ScatterGrid a(pieces, {&split}, {split.f()}, s), b(cells, {&split}, {split.f()}, s);
+  ASSERT_TRUE(a.collisions_per_photon() && b.collisions_per_photon());
+  std::printf("collisions per photon: pieces %.3f, cells %.3f; photons %d, %d\n", *a.collisions_per_photon(),
+              *b.collisions_per_photon(), a.photons(), b.photons());
+  EXPECT_GT(*b.collisions_per_photon(), 1.4 * *a.collisions_per_photon());
+  EXPECT_LT(b.photons(), a.photons());
+}
+
 }  // namespace
 }  // namespace nimbus

@@ -140,7 +140,7 @@ TEST(RenderSettings, AutoPhotonsFollowTheMediumsCollisions) {
   EXPECT_EQ(render(settings_sphere_scene(given, 4, 3, 0.3)).settings["photons"], 5000);
 }
 
-// "auto" beam photons in thin media (the scatter grid pilot's collisions per photon below 1.7): 2^15
+// "auto" beam photons in thin media (the scatter grid pilot's collisions per photon below 1.2): 2^15
 // sqrt(pixels / 128^2) for every directional or point light, seen from the side too. A side-lit sphere of
 // optical radius 0.3 traces 2^16 in a crop of a 256 x 256 image and 2^15 at 8 x 6; one of radius 10 (~4
 // collisions per photon) 2^15; with the scatter grid's photons given (no pilot) 2^15.
