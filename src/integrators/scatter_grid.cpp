@@ -638,7 +638,7 @@ std::vector<uint8_t> live_nodes(const NodeGrid& grid, const MajorantGrid& majora
 // pieces of constant-density shapes). A photon in a heterogeneous medium meets many null collisions, and
 // it is they that make it dear: the thin Disney cloud (0.82 real collisions per photon) took 2.04 x 2^18
 // photons by its real collisions alone, which cost more than they bought (error^2 x CPU 0.79x with 2^18 at
-// 128 x 128, 1.20x with 2.2 M against 2^20 at 512 x 512; docs/benchmarks.md, "Beam photons in thin media").
+// 128 x 128, 1.20x with 2.2 M against 2^20 at 512 x 512; docs/benchmarks.md, "The thin Disney cloud").
 constexpr int kPilotPhotons = 2048;
 constexpr double kDenseCollisions = 3.4;
 constexpr double kMaxPhotonFactor = 4.0;
