@@ -60,9 +60,9 @@ Imf::Header exr_image_header(const Image& img, const ImageMetadata& meta) {
                                        {img.origin_x + img.width - 1, img.origin_y + img.height - 1});
   }
   header.compression() = Imf::ZIP_COMPRESSION;
-  // zlib's fastest level: a nimbus EXR carries its resume state (exr_state.cpp: 17 UINT channels beside RGBA), and
-  // at OpenEXR's default level 4 compressing it took ~5 % of a 1-spp `mfs` render's CPU at 512 x 512 (the r = 1
-  // sphere: 2.30 -> 2.19 CPU s at level 1, the file 2 % larger).
+  // zlib's fastest level: a nimbus EXR carries its resume state (exr_state.cpp: 17 UINT channels beside
+  // RGBA), and at OpenEXR's default level 4 compressing it took ~5 % of a 1-spp `mfs` render's CPU at
+  // 512 x 512 (the r = 1 sphere: 2.30 -> 2.19 CPU s at level 1, the file 2 % larger).
   header.zipCompressionLevel() = 1;
   for (const char* c : {"R", "G", "B"}) header.channels().insert(c, Imf::Channel(Imf::FLOAT));
   if (!img.alpha.empty()) header.channels().insert("A", Imf::Channel(Imf::FLOAT));
