@@ -235,8 +235,10 @@ bool camera_in_forward_peak(const SceneContext& ctx, const Light& light, double 
 // backlit r = 10 sphere and 0.77x on the r = 20 one, but 1.06x on the side-lit r = 10 sphere and 1.07x on the
 // double HG one (their error did not fall). The full image's pixels, as auto_photons.
 // Thin media (`collisions`, the scatter grid pilot's real and null collisions per photon, below
-// kThinCollisions) take the larger count for every directional or point light (those the beam grid traces):
-// their beam photons are cheap and their noise is much of the error. At 512 x 512 (docs/benchmarks.md, "Beam
+// kThinCollisions) take the larger count for every light (the beam grid traces the directional and point ones;
+// the others' count is one too, so that the header holds one number: a render resumed from it gives its
+// photons, so it runs no pilot and could not resolve "auto" the same way): their beam photons are cheap
+// and their noise is much of the error. At 512 x 512 (docs/benchmarks.md, "Beam
 // photons in thin media"; 4 seeds) 4 x 2^15 gives 0.77x error^2 x CPU on the side-lit r = 1 sphere (C = 0.44)
 // and 0.85x on the r = 2 one (0.89), but 1.08x on the side-lit r = 10 sphere (4.4) and 1.09x on the box (3.8),
 // and 1.03x on the thin Disney cloud (0.82 real and 0.87 null collisions per photon: 1.69; its error did not
@@ -247,13 +249,10 @@ std::vector<int> auto_beam_photons(const SceneContext& ctx, double cut_angle,
   const double scale = std::min(8.0, pixel_scale(ctx.camera));
   const bool thin = collisions && *collisions < kThinCollisions;
   std::vector<int> n;
-  for (const Light& light : ctx.lights) {
-    const bool traced =
-        std::holds_alternative<DirectionalLight>(light) || std::holds_alternative<PointLight>(light);
-    n.push_back((thin && traced) || camera_in_forward_peak(ctx, light, cut_angle)
+  for (const Light& light : ctx.lights)
+    n.push_back(thin || camera_in_forward_peak(ctx, light, cut_angle)
                     ? int(std::round(kAutoBeamPhotons * scale))
                     : kAutoBeamPhotons);
-  }
   return n;
 }
 

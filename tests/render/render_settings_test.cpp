@@ -141,24 +141,38 @@ TEST(RenderSettings, AutoPhotonsFollowTheMediumsCollisions) {
 }
 
 // "auto" beam photons in thin media (the scatter grid pilot's collisions per photon below 1.2): 2^15
-// sqrt(pixels / 128^2) for every directional or point light, seen from the side too. A side-lit sphere of
-// optical radius 0.3 traces 2^16 in a crop of a 256 x 256 image and 2^15 at 8 x 6; one of radius 10 (~4
-// collisions per photon) 2^15; with the scatter grid's photons given (no pilot) 2^15.
+// sqrt(pixels / 128^2) for every light, seen from the side too. A side-lit sphere of optical radius 0.3
+// traces 2^16 in a crop of a 256 x 256 image and 2^15 at 8 x 6; one of radius 10 (~4 collisions per photon)
+// 2^15; with the scatter grid's photons given (no pilot) 2^15. With a spot light beside the sun (which the beam
+// grid does not trace) the header holds one count too, and the scene in the header (its photons given, so no
+// pilot: "auto" could not be resolved again) renders the same image.
 TEST(RenderSettings, AutoBeamPhotonsFollowThePixelsInThinMedia) {
-  const auto scene = [](double sigma_s, int size, const std::string& photons) {
+  const std::string sun = R"({"type": "directional", "direction": [-1, 0.3, 0.2], "irradiance": 1.0})";
+  const auto scene = [&](double sigma_s, int size, const std::string& photons, const std::string& lights) {
     return test::scene_from_json("{" + test::camera_json(size, size) + R"(,
       "media": [{"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1}, "sigma_s": )" +
                                  std::to_string(sigma_s) + R"(, "phase": {"type": "hg", "g": 0.8}}],
-      "lights": [{"type": "directional", "direction": [-1, 0.3, 0.2], "irradiance": 1.0}],
+      "lights": [)" + lights + R"(],
       "integrator": {"type": "mfs", "spp": 1, "photons": )" +
                                  photons + R"(, "scatter_grid_resolution": 8}})");
   };
   RenderOptions crop;
   crop.region = Region{128, 128, 129, 129};
-  EXPECT_EQ(render(scene(0.3, 256, "\"auto\""), crop).settings["beam_photons"], 1 << 16);
-  EXPECT_EQ(render(scene(0.3, 8, "\"auto\"")).settings["beam_photons"], 1 << 15);
-  EXPECT_EQ(render(scene(10.0, 256, "\"auto\""), crop).settings["beam_photons"], 1 << 15);
-  EXPECT_EQ(render(scene(0.3, 256, "4096"), crop).settings["beam_photons"], 1 << 15);
+  EXPECT_EQ(render(scene(0.3, 256, "\"auto\"", sun), crop).settings["beam_photons"], 1 << 16);
+  EXPECT_EQ(render(scene(0.3, 8, "\"auto\"", sun)).settings["beam_photons"], 1 << 15);
+  EXPECT_EQ(render(scene(10.0, 256, "\"auto\"", sun), crop).settings["beam_photons"], 1 << 15);
+  EXPECT_EQ(render(scene(0.3, 256, "4096", sun), crop).settings["beam_photons"], 1 << 15);
+  const std::string spot =
+      R"({"type": "spot", "position": [0.5, 6, 0], "direction": [0, -1, 0], "intensity": 10.0, "cone_angle_deg": 60})";
+  const RenderResult first = render(scene(0.3, 256, "\"auto\"", sun + ", " + spot), crop);
+  EXPECT_EQ(first.settings["beam_photons"], 1 << 16);
+  const Scene again = parse_scene(nlohmann::json::parse(meta(first, "nimbus/scene")), "header", ".");
+  ASSERT_EQ(again.lights.size(), 2u);
+  const RenderResult second = render(again, crop);
+  ASSERT_EQ(second.image.rgb.size(), first.image.rgb.size());
+  EXPECT_EQ(
+      std::memcmp(second.image.rgb.data(), first.image.rgb.data(), first.image.rgb.size() * sizeof(float)),
+      0);
 }
 
 // "auto" beam photons: 2^15 per light, and 2^15 sqrt(pixels / 128^2) for a light whose forward peak the
