@@ -57,6 +57,7 @@ MfsIntegrator::MfsIntegrator(const SceneContext& context, MfsSettings settings, 
   const MajorantGrid* tracking = photon_majorants ? &*photon_majorants : nullptr;
   std::vector<const PhaseSplit*> splits;  // for the photon grids
   for (const auto& sp : splits_) splits.push_back(sp.get());
+  if (!s_.scatter_grid_bands) s_.scatter_grid_bands = auto_scatter_grid_bands(splits);
   // Wide scatters 2 .. K from the scatter grid (for K = 1 only the environment's light).
   if (s_.large_angle_scatters != 0 &&
       (s_.large_angle_scatters != 1 || ctx_.has_environment || ctx_.media.emits())) {

@@ -44,10 +44,10 @@
 // | `photon_transport`        | "exact" or "similarity"       | "exact"   | scatter grid photons in the true medium, or in the delta-scaled one |
 // | `channel_passes`          | boolean                       | false     | chromatic media: one scatter grid photon pass per colour channel (each with its own coefficients) instead of one pass of hero-channel photons carrying all three (scatter_grid.h) |
 // | `scatter_grid_resolution` | "auto" or integer in [4, 96]  | "auto"    | scatter and beam grid nodes along the longest axis ("auto": ~1.6 optical depths per cell, 32 to 64, from 512 x 512 pixels on; 3/4 of that up to 128 x 128; the header of a rendered image holds the number chosen) |
-// | `scatter_grid_bands`      | integer in [1, 3]             | 3         | spherical-harmonic bands used at lookup (l < bands) |
+// | `scatter_grid_bands`      | "auto" or integer in [1, 6]   | "auto"    | spherical-harmonic bands the grid keeps and reads (l < bands; "auto": 1 where every medium scatters isotropically without a peak, else 3) |
 // | `grid_denoise`            | boolean                       | true      | the scatter grid's nodes inside the media filtered where their difference from their neighbours is photon noise, by the photon batches' spread (grid_denoise.h) |
 // | `forward_side`            | "camera" or "light"           | "camera"  | peak scatters after the last wide scatter carried to the camera, or taken on the light's side with an exact camera leg |
-// | `beam_photons`            | "auto" or integer in [0, 2^24] | "auto"  | photons per light for the peak-only beam grid, shared among the channels' passes in chromatic media (0: straight beams; "auto": 2^15, and 2^15 sqrt(pixels / 128^2), at most 8 x 2^15, for a light whose forward peak the camera looks into, and for every light in thin media (the scatter grid pilot's collisions per photon below 1.2): auto_beam_photons in mfs_settings.cpp) |
+// | `beam_photons`            | "auto" or integer in [0, 2^24] | "auto"  | photons per light for the peak-only beam grid, shared among the channels' passes in chromatic media (0: straight beams; "auto": 2^15, and 2^15 sqrt(pixels / 128^2), at most 8 x 2^15, for a light whose forward peak the camera looks into, and for every light in thin media (the scatter grid pilot's collisions per photon below 1.2), and none where no medium has a peak: auto_beam_photons in mfs_settings.cpp) |
 // | `beam_spread`             | "straight" or "traced"        | "straight" | the peak-only light's angular spread: the straight beam's peak depth ln(T_wide / T_light) (D8), or the beam grid's photons' mean cosine read against the straight beam's (D9b; backlit spheres' binned error 1.4x, docs/benchmarks.md "The beam's spread") |
 // | `beam_smoothing`          | integer in [0, 8]             | 2         | passes of the filter [1 2 1] / 4 along each axis over the beam grid's nodes inside the media (0: none): the grid's noise averaged over about one node spacing (BeamGrid) |
 // | `photon_splat`            | "trilinear", "stochastic" or "stratified" | "trilinear" | how the scatter grid's photons deposit each track sample: over the 8 nodes around it, or whole to one of them drawn by its trilinear weight (independently, or stratified along the track); the same expected grid, more noise (the beam grid stays trilinear) |
@@ -106,7 +106,8 @@ struct MfsSettings {
   PhotonTransport photon_transport = PhotonTransport::exact;
   bool channel_passes = false;
   std::optional<int> scatter_grid_resolution;  // nullopt: "auto" (resolved by MfsIntegrator)
-  int scatter_grid_bands = 3;
+  std::optional<int>
+      scatter_grid_bands;  // nullopt: "auto" (resolved by MfsIntegrator: auto_scatter_grid_bands)
   ForwardSide forward_side = ForwardSide::camera;
   std::optional<int>
       beam_photons;  // nullopt: "auto" (resolved per light by MfsIntegrator: auto_beam_photons)

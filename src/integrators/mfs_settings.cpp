@@ -36,7 +36,8 @@ MfsSettings mfs_settings_from_json(const nlohmann::json& options, const std::str
   s.channel_passes = o.boolean("channel_passes", s.channel_passes);
   if (int64_t n = 0; o.keyword_or_integer("scatter_grid_resolution", "auto", 4, 96, &n))
     s.scatter_grid_resolution = int(n);
-  s.scatter_grid_bands = int(o.integer("scatter_grid_bands", 1, kShMaxBands, s.scatter_grid_bands));
+  if (int64_t n = 0; o.keyword_or_integer("scatter_grid_bands", "auto", 1, kShMaxBands, &n))
+    s.scatter_grid_bands = int(n);
   s.forward_side = ForwardSide(o.choice("forward_side", kForwardSideNames, int(s.forward_side)));
   if (int64_t n = 0; o.keyword_or_integer("beam_photons", "auto", 0, 1 << 24, &n)) s.beam_photons = int(n);
   s.beam_spread = BeamSpread(o.choice("beam_spread", kBeamSpreadNames, int(s.beam_spread)));
@@ -77,7 +78,6 @@ nlohmann::json to_json(const MfsSettings& s) {
                       {"propagator", kPropagatorNames[int(s.propagator)]},
                       {"photon_transport", kPhotonTransportNames[int(s.photon_transport)]},
                       {"channel_passes", s.channel_passes},
-                      {"scatter_grid_bands", s.scatter_grid_bands},
                       {"forward_side", kForwardSideNames[int(s.forward_side)]},
                       {"beam_spread", kBeamSpreadNames[int(s.beam_spread)]},
                       {"beam_smoothing", s.beam_smoothing},
@@ -94,6 +94,8 @@ nlohmann::json to_json(const MfsSettings& s) {
                       {"peak_toward_camera", s.peak_toward_camera},
                       {"wide_toward_camera", s.wide_toward_camera},
                       {"shadow_map_resolution", s.shadow_map_resolution}};
+  j["scatter_grid_bands"] =
+      s.scatter_grid_bands ? nlohmann::json(*s.scatter_grid_bands) : nlohmann::json("auto");
   j["edge_samples"] = s.edge_samples ? nlohmann::json(*s.edge_samples) : nlohmann::json("auto");
   j["peak_fraction"] = s.peak_fraction ? nlohmann::json(*s.peak_fraction) : nlohmann::json("auto");
   j["large_angle_scatters"] =
@@ -174,6 +176,23 @@ int auto_scatter_grid_resolution(const SceneContext& ctx) {
   return int(std::round(nodes * scale));
 }
 
+// "auto" scatter-grid bands. The camera side reads the grid's light through the wide part's moments chi_l
+// (blurred by the peak, eq. D12; forward_side "light": the whole phase function's): where every medium's
+// phase function is isotropic and carried without a peak (f = 0, as "auto" gives it: g^2), chi_l is 0 for
+// l >= 1 and one band (the fluence) gives the same image, for a ninth of the floats per photon deposit (the
+// isotropic Cycles-comparison sphere `a_sphere_iso_sun` at 128 x 128: 0.76x the CPU with the beam grid off
+// too, its error unchanged; docs/benchmarks.md, "Isotropic media").
+int auto_scatter_grid_bands(const std::vector<const PhaseSplit*>& splits) {
+  constexpr double kZero = 1e-9;
+  for (const PhaseSplit* split : splits) {
+    if (split->f() > 0.0) return 3;
+    const std::vector<double>& chi = split->wide_moments();
+    for (size_t l = 1; l < 3 && l < chi.size(); ++l)
+      if (std::abs(chi[l]) > kZero) return 3;
+  }
+  return 1;
+}
+
 // "auto" scatter-grid photons: 2^18 up to 128 x 128 pixels, then 2^18 sqrt(pixels / 128^2). A grid of N
 // photons costs c N of set-up and leaves a noise a / N in the error^2 beside mfs's bias b^2; the rest of the
 // render costs F (the march, growing with the pixels). (b^2 + a / N) (F + c N) is least at
@@ -242,12 +261,16 @@ bool camera_in_forward_peak(const SceneContext& ctx, const Light& light, double 
 // photons in thin media"; 4 seeds) 4 x 2^15 gives 0.77x error^2 x CPU on the side-lit r = 1 sphere (C = 0.44)
 // and 0.85x on the r = 2 one (0.89), but 1.08x on the side-lit r = 10 sphere (4.4) and 1.09x on the box (3.8),
 // and 1.03x on the thin Disney cloud (0.82 real and 0.87 null collisions per photon: 1.69; its error did not
-// move), which stays below the threshold; at 128 x 128 the count stays 2^15.
+// move), which stays below the threshold; at 128 x 128 the count stays 2^15. Where no medium has a peak (an
+// isotropic medium, f = 0): none.
 constexpr double kThinCollisions = 1.2;
 std::vector<int> auto_beam_photons(const SceneContext& ctx, double cut_angle,
                                    std::optional<double> collisions) {
   const double scale = std::min(8.0, pixel_scale(ctx.camera));
   const bool thin = collisions && *collisions < kThinCollisions;
+  // Without a peak (f = 0 in every medium) a scatter is always a wide one: the peak-only beam is the
+  // unscattered light, which the straight beam has exactly; a beam grid would only add its noise.
+  if (!(cut_angle > 0.0)) return std::vector<int>(ctx.lights.size(), 0);
   std::vector<int> n;
   for (const Light& light : ctx.lights)
     n.push_back(thin || camera_in_forward_peak(ctx, light, cut_angle)
@@ -280,7 +303,7 @@ ScatterGridSettings scatter_grid_settings(const MfsSettings& s, bool adaptive, u
   grid.max_wide_scatters = s.large_angle_scatters.value_or(0);
   grid.exact_transport = s.photon_transport == PhotonTransport::exact;
   grid.channel_passes = s.channel_passes;
-  grid.bands = s.scatter_grid_bands;
+  grid.bands = *s.scatter_grid_bands;
   grid.live_nodes_only = !s.filtered_lookups;  // the pre-filtered levels read every node
   grid.prefiltered = s.filtered_lookups;       // only filtered lookups read them
   grid.splat = s.photon_splat;

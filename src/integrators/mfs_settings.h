@@ -15,9 +15,13 @@ std::optional<MajorantGrid> photon_majorant_grid(const SceneContext& ctx, const 
                                                  const std::vector<int>& beam_counts);
 // "auto" scatter (and beam) grid nodes along the media's longest axis.
 int auto_scatter_grid_resolution(const SceneContext& ctx);
+// "auto" scatter-grid bands: 1 where every medium scatters isotropically (no peak, and its phase function's
+// moments for l = 1, 2 vanish), else 3.
+int auto_scatter_grid_bands(const std::vector<const PhaseSplit*>& splits);
 // "auto" scatter-grid photons from the whole image's pixels.
 int auto_photons(const PinholeCamera& camera);
-// "auto" beam-grid photons per light, given the widest peak's cut angle [rad].
+// "auto" beam-grid photons per light, given the widest peak's cut angle [rad] (0: no medium has a peak, and
+// every light gets none).
 std::vector<int> auto_beam_photons(const SceneContext& ctx, double cut_angle,
                                    std::optional<double> collisions = std::nullopt);
 // "auto" edge samples (MfsSettings::edge_samples), given the widest peak's cut angle [rad].

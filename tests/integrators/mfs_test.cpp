@@ -242,6 +242,8 @@ TEST(Mfs, OptionsAreValidatedStrictly) {
   EXPECT_THROW(parse(R"({"photon_transport": "fast"})"), Error);
   EXPECT_THROW(parse(R"({"forward_side": "both"})"), Error);
   EXPECT_THROW(parse(R"({"scatter_grid_bands": 7})"), Error);
+  EXPECT_NO_THROW(parse(R"({"scatter_grid_bands": "auto"})"));
+  EXPECT_THROW(parse(R"({"scatter_grid_bands": "few"})"), Error);
   EXPECT_NO_THROW(parse(R"({"large_angle_scatters": 0})"));
   EXPECT_THROW(parse(R"({"large_angle_scatters": -1})"), Error);
   EXPECT_THROW(parse(R"({"large_angle_scatters": "many"})"), Error);

@@ -243,6 +243,42 @@ TEST(RenderSettings, AutoExactLightTransmittanceIsTheChordForOneShape) {
   EXPECT_EQ(render(two).settings["exact_light_transmittance"], false);
 }
 
+// Isotropic media (no peak: "auto" f = g^2 = 0): the scatter grid keeps one band, the fluence (the camera
+// side reads it through the phase function's moments, 0 for l >= 1), and there is no beam grid (the
+// peak-only beam is the unscattered light, which the straight beam has exactly). The image is the one with
+// three bands asked for, bit for bit. HG 0.8, and a scene with an HG medium beside an isotropic one, keep
+// three bands and the beam grid; a number given is kept.
+TEST(RenderSettings, AutoBandsAndBeamPhotonsForIsotropicMedia) {
+  const auto scene = [](const std::string& phase, const std::string& integrator, const std::string& second) {
+    return test::scene_from_json("{" + test::camera_json(8, 6) + R"(,
+      "media": [{"shape": {"type": "sphere", "center": [-0.3, 0, 0], "radius": 0.8}, "sigma_s": 2.0,
+                 "sigma_a": 0.2, "phase": )" +
+                                 phase + "}" + second + R"(],
+      "lights": [{"type": "directional", "direction": [-1, 0.3, 0.2], "irradiance": 1.0}],
+      "integrator": {"type": "mfs", "spp": 1, "photons": 4096)" +
+                                 integrator + "}}");
+  };
+  const std::string iso = R"({"type": "isotropic"})", hg0 = R"({"type": "hg", "g": 0.0})";
+  const std::string hg = R"({"type": "hg", "g": 0.8})";
+  const RenderResult a = render(scene(iso, "", ""));
+  EXPECT_EQ(a.settings["scatter_grid_bands"], 1);
+  EXPECT_EQ(a.settings["beam_photons"], 0);
+  const RenderResult b = render(scene(iso, R"(, "scatter_grid_bands": 3, "beam_photons": 0)", ""));
+  EXPECT_EQ(b.settings["scatter_grid_bands"], 3);
+  ASSERT_EQ(a.image.rgb.size(), b.image.rgb.size());
+  EXPECT_EQ(std::memcmp(a.image.rgb.data(), b.image.rgb.data(), a.image.rgb.size() * sizeof(float)), 0);
+  EXPECT_EQ(render(scene(hg0, "", "")).settings["scatter_grid_bands"], 1);
+  const RenderResult h = render(scene(hg, "", ""));
+  EXPECT_EQ(h.settings["scatter_grid_bands"], 3);
+  EXPECT_GT(h.settings["beam_photons"].get<int>(), 0);
+  const std::string beside = R"(, {"shape": {"type": "sphere", "center": [0.6, 0, 0], "radius": 0.3},
+                                   "sigma_s": 2.0, "phase": {"type": "hg", "g": 0.8}})";
+  const RenderResult mixed = render(scene(iso, "", beside));
+  EXPECT_EQ(mixed.settings["scatter_grid_bands"], 3);
+  EXPECT_GT(mixed.settings["beam_photons"].get<int>(), 0);
+  EXPECT_EQ(render(scene(iso, R"(, "scatter_grid_bands": 2)", "")).settings["scatter_grid_bands"], 2);
+}
+
 TEST(RenderSettings, OverridesAreWhatTheHeaderSays) {
   const Scene scene =
       settings_sphere_scene(R"({"type": "pathtrace", "spp": 2, "seed": 5, "max_wide_scatters": 1})");
