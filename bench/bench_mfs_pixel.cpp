@@ -175,10 +175,10 @@ void BM_MfsPixelSkeleton(benchmark::State& state) {
       const double jitter = rng.uniform();
       uint32_t n = 0;
       const auto scale = [&](double, double) { return 1.0 + s.step_growth * max_component(cam.tau_red); };
-      const auto step = [&](const Vec3& q, double t, double dt) {
+      const auto step = [&](const Vec3& q, double t, double dt, double u) {
         ++n;
         ctx.media.eval(q, &mp);
-        cam.advance(mfs_extinction(mp, f, theta2), t, dt, jitter);
+        cam.advance(mfs_extinction(mp, f, theta2), t, dt, u);
         return max_component(cam.T_red) > 1e-6;
       };
       const double inf = std::numeric_limits<double>::infinity();

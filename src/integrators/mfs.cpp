@@ -153,7 +153,7 @@ Rgb MfsIntegrator::trace(const Ray& ray, Rng& rng, CameraSample* sample, int bou
   const bool on_surface = ctx_.surfaces.intersect(o, d, std::numeric_limits<double>::infinity(), &hit);
   Rgb L(0.0);
   CameraPath cam;  // from the camera to the current step: T_full, T_red, tau_p, theta_p, tau_red, m0..m2
-  const double jitter = rng.uniform();
+  const double jitter = rng.uniform();  // the march's first offset (StepOffsets: the others follow)
   std::optional<FootprintProbe> probe = footprint_probe(d, rng);  // camera_tilt's offsets (eq. D16)
   MediumPoint mp;
   MarchRecorder layers(sample);  // direct: the lights' light that took at most one wide scatter
@@ -166,7 +166,7 @@ Rgb MfsIntegrator::trace(const Ray& ray, Rng& rng, CameraSample* sample, int bou
                ? std::min(1.0, kEmissionStep / s_.tau_step)
                : 1.0 + s_.step_growth * max_component(cam.tau_red);
   };
-  const auto step = [&](const Vec3& p, double t, double dt) {
+  const auto step = [&](const Vec3& p, double t, double dt, double u) {
     ++mfs_march_steps;
     // Split the extinction at p into peak and reduced parts (eq. D2).
     ctx_.media.eval(p, &mp);
@@ -174,7 +174,7 @@ Rgb MfsIntegrator::trace(const Ray& ray, Rng& rng, CameraSample* sample, int bou
     Rgb L_step(0.0);
     // Add what each medium scatters towards the camera at the sample point y = p.
     if (max_component(mp.sigma_s) > 0.0) {
-      const CameraPoint y = cam.at(k, jitter, dt, s_.light_side(), s_.path_lengthening, s_.camera_fluence);
+      const CameraPoint y = cam.at(k, u, dt, s_.light_side(), s_.path_lengthening, s_.camera_fluence);
       const Sources src = step_sources(mp, p, d, y_out, t, y, cam, rng, probe ? &*probe : nullptr);
       L_step = (y.T_cam * src.in_scatter + y.T_full * src.peak_scatter) * dt;
       L += L_step;
@@ -182,13 +182,13 @@ Rgb MfsIntegrator::trace(const Ray& ray, Rng& rng, CameraSample* sample, int bou
     }
     // Advance the camera-side state over the whole step.
     const Rgb T0 = s_.light_side() ? cam.T_full : cam.T_red;
-    cam.advance(k, t, dt, jitter);
+    cam.advance(k, t, dt, u);
     if (ctx_.media.emits()) {  // emission along the ray, through the same transmittance as the grid's light
       const Rgb E = emission_over_step(mp.emission, T0, s_.light_side() ? cam.T_full : cam.T_red, dt);
       L += E;
       L_step += E;
     }
-    layers.step(t - jitter * dt, dt, T0, s_.light_side() ? cam.T_full : cam.T_red, mp, L_step);
+    layers.step(t - u * dt, dt, T0, s_.light_side() ? cam.T_full : cam.T_red, mp, L_step);
     return max_component(s_.light_side() ? cam.T_full : cam.T_red) > 1e-6;
   };
   // Constant-density shapes: steps over their pieces, by optical depth alone (tracking.h).

@@ -141,8 +141,8 @@ TEST(Tracking, AnalyticFreeFlightsMatchBeerLambert) {
 
 // The growing march over the pieces (integrators/tracking.h, `mfs`'s march on constant-density shapes):
 // the steps tile each piece exactly, none is longer than max_step or deeper than tau_step x scale at the
-// piece's extinction, each sample sits at `offset` of its step inside its piece, the optical depth sums to
-// -log T, and a step that returns false ends the march.
+// piece's extinction, each sample sits at its offset (StepOffsets) in its step inside its piece, the optical depth sums to
+// -log T, and a step that returns false ends the march. (The offsets: StepOffsets, below.)
 TEST(Tracking, AnalyticMarchTilesThePiecesByOpticalDepth) {
   const SceneMedia media = media_of(R"([
     {"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1}, "sigma_s": 2.0,
@@ -160,10 +160,12 @@ TEST(Tracking, AnalyticMarchTilesThePiecesByOpticalDepth) {
   double depth = 0.0, growth = 0.0, end = 0.0;
   size_t piece = 0;
   int steps = 0;
+  StepOffsets expected(offset);
   march_growing(
       a, o, d, 10.0, tau_step, max_step, offset, [&](double, double) { return 1.0 + growth; },
-      [&](const Vec3& p, double t, double dt) {
-        const double t_start = t - offset * dt;
+      [&](const Vec3& p, double t, double dt, double u) {
+        EXPECT_NEAR(u, expected.next(), 1e-15);  // the golden-ratio offsets, step by step along the ray
+        const double t_start = t - u * dt;
         while (piece < pieces.size() && t_start >= pieces[piece][1] - 1e-12) ++piece;
         EXPECT_LT(piece, pieces.size());
         if (piece >= pieces.size()) return false;
@@ -187,8 +189,49 @@ TEST(Tracking, AnalyticMarchTilesThePiecesByOpticalDepth) {
   int taken = 0;
   march_growing(
       a, o, d, 10.0, tau_step, max_step, offset, [](double, double) { return 1.0; },
-      [&](const Vec3&, double, double) { return ++taken < 3; });
+      [&](const Vec3&, double, double, double) { return ++taken < 3; });
   EXPECT_EQ(taken, 3);
+}
+
+// The growing march's step offsets (StepOffsets): each step's sample is uniform within it for a uniform first
+// offset, and along the ray the offsets spread over [0, 1), so a falling integrand's steps do not all err
+// the same way. The sum over the steps of exp(-tau) dt through a sphere of optical diameter 4 (20 steps of
+// 0.2) against the exact 1 - exp(-4), over first offsets spread through [0, 1): with one offset for every step
+// the error is as large as half a step's fall (10 %) at the ends of [0, 1), 5.8 % rms; with the golden-ratio
+// offsets at most 1.9 %, 0.9 % rms; averaged over the first offset both are exact (within the quadrature's
+// 1e-3).
+TEST(Tracking, GrowingMarchOffsetsCancelAlongTheRay) {
+  const SceneMedia media = media_of(R"([
+    {"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1}, "sigma_s": 2.0}])");
+  const AnalyticMedia a(media);
+  const Vec3 o(0, -3, 0), d(0, 1, 0);
+  const double exact = 1.0 - std::exp(-4.0);
+  double worst = 0.0, worst_shared = 0.0, mean = 0.0, mean_shared = 0.0, ms = 0.0, ms_shared = 0.0;
+  constexpr int kOffsets = 1000;
+  for (int i = 0; i < kOffsets; ++i) {
+    const double u0 = (i + 0.5) / kOffsets;
+    double sum = 0.0, shared = 0.0;
+    march_growing(
+        a, o, d, 10.0, 0.2, 10.0, u0, [](double, double) { return 1.0; },
+        [&](const Vec3&, double t, double dt, double u) {
+          sum += 2.0 * std::exp(-2.0 * (t - 2.0)) * dt;  // sigma_t T(t), the sphere entered at t = 2
+          const double t_shared = t - u * dt + u0 * dt;
+          shared += 2.0 * std::exp(-2.0 * (t_shared - 2.0)) * dt;
+          return true;
+        });
+    worst = std::max(worst, std::abs(sum / exact - 1.0));
+    worst_shared = std::max(worst_shared, std::abs(shared / exact - 1.0));
+    mean += sum / kOffsets;
+    mean_shared += shared / kOffsets;
+    ms += std::pow(sum / exact - 1.0, 2) / kOffsets;
+    ms_shared += std::pow(shared / exact - 1.0, 2) / kOffsets;
+  }
+  EXPECT_LT(std::sqrt(ms), 0.015);        // 0.9 %
+  EXPECT_GT(std::sqrt(ms_shared), 0.04);  // 5.8 %
+  EXPECT_LT(worst, 0.025);                // 1.9 %
+  EXPECT_GT(worst_shared, 0.08);          // 10 %
+  EXPECT_NEAR(mean / exact, 1.0, 1e-3);
+  EXPECT_NEAR(mean_shared / exact, 1.0, 1e-3);
 }
 
 }  // namespace
