@@ -34,8 +34,8 @@
 //
 // | field                     | type                          | default   | meaning                               |
 // |---------------------------|-------------------------------|-----------|---------------------------------------|
-// | `tau_step`                | number in [1e-4, 100]         | 0.2       | optical depth per march step (against the majorant) |
-// | `step_growth`             | number in [0, 100]            | 3         | steps of tau_step (1 + step_growth tau_red), tau_red the camera-side reduced depth; fixed steps of min(tau_step, 0.1) in the majorant cells where a medium may emit; on constant-density spheres and boxes each step is also at most one node spacing of the photon grids (docs/derivations.md D13) |
+// | `tau_step`                | number in [1e-4, 100]         | 0.4       | optical depth per march step (against the majorant) |
+// | `step_growth`             | number in [0, 100]            | 3         | steps of tau_step (1 + step_growth tau_red), tau_red the camera-side reduced depth; fixed steps of min(tau_step, 0.1) in the majorant cells where a medium may emit; on constant-density spheres and boxes each step is also at most two node spacings of the photon grids (docs/derivations.md D13) |
 // | `light_path`              | "forward" or "beer_lambert"   | "forward" | the light reaches the first wide scatter through peak scatters (reduced extinction), or unscattered only (the seed paper) |
 // | `propagator`              | "gsa" or "gaussian"           | "gsa"     | the peak's own moments in the small-angle propagator, or a Gaussian stand-in with the same theta2 |
 // | `peak_fraction`           | "auto" or [0, 0.99]           | "auto"    | f, the part of each phase function carried as a forward peak ("auto": g^2 per medium) |
@@ -96,7 +96,7 @@ enum class BeamSpread { straight, traced };
 inline constexpr double kEmissionStep = 0.1;
 
 struct MfsSettings {
-  double tau_step = 0.2;
+  double tau_step = 0.4;
   double step_growth = 3.0;
   LightPath light_path = LightPath::forward;
   Propagator propagator = Propagator::gsa;
