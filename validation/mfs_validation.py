@@ -572,10 +572,11 @@ def best_mfs(r):
 
 def needs_for_100x(r, m):
     """What 100x would take at this mfs point: its CPU time at the same error (the judge's time / 100), or its
-    error (reference noise removed) at the same time (solving the better fitted curve for 100 x its time)."""
+    error (reference noise removed) at the same time (solving the faster judge's fitted curve, uniform or adaptive,
+    for 100 x its time: the judge the speed-up is measured against)."""
     f, T = r["fit"], 100 * m["cpu_s"]
     gains = [f["k_cpu_s"] * f["c2"]] + ([f["adaptive_A"]["cpu_s"]] if f["adaptive_A"] else [])
-    e_need = math.sqrt(max(gains) / max(T - f["t0_cpu_s"], 1e-9))
+    e_need = math.sqrt(min(gains) / max(T - f["t0_cpu_s"], 1e-9))
     eq = m["equal_error"]
     t_pt = min(t for t in (eq["uniform_cpu_s"], eq["adaptive_cpu_s"]) if t is not None)
     return t_pt / 100, e_need
