@@ -28,6 +28,23 @@ double peak_drift(const PhaseSplit& split) {
   return split.f() > 0.0 && chi.size() > 1 ? std::max(0.0, 1.0 - chi[1]) : 0.0;
 }
 
+double pieces_max_step(const SceneContext& ctx, const ScatterGrid* grid, const BeamGrid* beam) {
+  // The pieces' march (constant-density shapes) steps at most kMaxStepSpacings node spacings of the photon
+  // grids: the light they hold varies on that scale (the majorant grid's cells, of about the size of one,
+  // bound the steps elsewhere). Without grids, kMaxStepSpacings / 32 of the media's extent, as those cells.
+  // (The spacing along the grids' longest axis: a flat box's thin axis has a spacing of its own thickness.)
+  // One spacing while the steps shared their offset; with StepOffsets (tracking.h) two cost 0.74-0.84x the
+  // CPU at 512 x 512 for the same error within 0.04 points (docs/benchmarks.md, "The march's offsets").
+  constexpr double kMaxStepSpacings = 2.0;
+  const auto spacing = [](const NodeGrid& g) { return std::max({g.spacing.x, g.spacing.y, g.spacing.z}); };
+  const Vec3 extent = ctx.media.bounds().hi - ctx.media.bounds().lo;
+  double step = std::max({extent.x, extent.y, extent.z}) / 32.0;
+  if (grid) step = std::min(step, spacing(grid->node_grid()));
+  if (beam) step = std::min(step, spacing(beam->node_grid()));
+  step *= kMaxStepSpacings;
+  return step > 0.0 ? step : std::numeric_limits<double>::infinity();  // no media: no pieces
+}
+
 }  // namespace
 
 MfsIntegrator::MfsIntegrator(const SceneContext& context, MfsSettings settings, uint64_t seed)
@@ -72,20 +89,7 @@ MfsIntegrator::MfsIntegrator(const SceneContext& context, MfsSettings settings, 
       std::all_of(beam_counts_.begin(), beam_counts_.end(), [&](int n) { return n == beam_counts_[0]; }))
     s_.beam_photons = beam_counts_[0];  // the header's settings: one count for every light, or "auto"
   if (beam_on()) build_beam(splits, tracking, seed);
-  // The pieces' march (constant-density shapes) steps at most kMaxStepSpacings node spacings of the photon
-  // grids: the light they hold varies on that scale (the majorant grid's cells, of about the size of one,
-  // bound the steps elsewhere). Without grids, kMaxStepSpacings / 32 of the media's extent, as those cells.
-  // (The spacing along the grids' longest axis: a flat box's thin axis has a spacing of its own thickness.)
-  // One spacing while the steps shared their offset; with StepOffsets (tracking.h) two cost 0.74-0.84x the
-  // CPU at 512 x 512 for the same error within 0.04 points (docs/benchmarks.md, "The march's offsets").
-  constexpr double kMaxStepSpacings = 2.0;
-  const auto spacing = [](const NodeGrid& g) { return std::max({g.spacing.x, g.spacing.y, g.spacing.z}); };
-  const Vec3 extent = ctx_.media.bounds().hi - ctx_.media.bounds().lo;
-  max_step_ = std::max({extent.x, extent.y, extent.z}) / 32.0;
-  if (grid_) max_step_ = std::min(max_step_, spacing(grid_->node_grid()));
-  if (beam_) max_step_ = std::min(max_step_, spacing(beam_->node_grid()));
-  max_step_ *= kMaxStepSpacings;
-  if (!(max_step_ > 0.0)) max_step_ = std::numeric_limits<double>::infinity();  // no media (no pieces)
+  max_step_ = pieces_max_step(ctx_, grid_.get(), beam_.get());
   if (grid_ && beam_) {
     const NodeGrid &a = grid_->node_grid(), &b = beam_->node_grid();
     shared_stencil_ = a.bounds.lo == b.bounds.lo && a.bounds.hi == b.bounds.hi && a.nodes == b.nodes &&
