@@ -315,6 +315,9 @@ struct ScatterPhotons {
   // `pieces`, the full extinction): its majorant is the extinction wherever a tentative collision falls.
   bool exact_pieces;
   std::vector<SourceBlock> blocks;  // per source, as trace numbers them
+  // Whether flights are deposited: the pilot (pilot_collisions) only counts collisions, so its tally's
+  // pages are never touched. The walks draw the same numbers either way.
+  bool deposits = true;
 
   void split(int photons);  // first = photon_split(..., photons, ...), and surface
   void trace(size_t j, Rng& rng, PhotonBatch& batch) const;
@@ -392,9 +395,11 @@ void ScatterPhotons::trace(size_t j, Rng& rng, PhotonBatch& batch) const {
         return real;
       },
       [&](const Vec3& x, const Vec3& w, double t_end) {
-        if (order >= first_order)
+        if (order < first_order) return;
+        const double u = offset(rng);  // drawn whether or not the flight is deposited (deposits)
+        if (deposits)
           deposit_flight(batch.tally.data(), block, grid, live, bands, x, w, t_end, power * weight,
-                         s.deposit_step, offset(rng), corners);
+                         s.deposit_step, u, corners);
       },
       [&](const Vec3& xc, Vec3* w) { return scatter(xc, w, c, &weight, &order, rng, batch); },
       [&](const SurfaceHit& hit, Vec3* w) { return reflect(hit, w, c, &weight, &order, rng); });
@@ -498,9 +503,11 @@ void ScatterPhotons::trace_hero(const Photon& ph, int hero, const Rgb& share, co
   // weight at its end biases the channels: the denser ones ~10 % low in the test's sphere).
   Vec3 seg = ph.x;  // where the current segment starts (on the current flight)
   const auto deposit = [&](const Vec3& w, double len) {
-    if (order >= first_order)
+    if (order < first_order) return;
+    const double u = offset(rng);  // drawn whether or not the flight is deposited (deposits)
+    if (deposits)
       deposit_flight(batch.tally.data(), block, grid, live, bands, seg, w, len, ph.power * walk.weight(),
-                     s.deposit_step, offset(rng), corners);
+                     s.deposit_step, u, corners);
   };
   Vec3 dir = ph.w;  // the current flight's direction
   walk_photon(
@@ -655,9 +662,10 @@ void ScatterPhotons::split(int photons) {
 }
 
 // Real and null collisions per photon of kPilotPhotons photons of a pass (photons.first is left split for
-// them), traced serially on streams of their own into a tally that is dropped.
+// them), traced serially on streams of their own, their flights not deposited (ScatterPhotons::deposits).
 double pilot_collisions(ScatterPhotons& photons, size_t tally_size) {
   photons.split(kPilotPhotons);
+  photons.deposits = false;
   ZeroedFloats tally(tally_size);
   PhotonBatch batch;
   batch.tally = {tally.data(), tally_size};
@@ -666,6 +674,7 @@ double pilot_collisions(ScatterPhotons& photons, size_t tally_size) {
     Rng rng(photons.s.seed ^ 0x70696c6f74ull, j);
     photons.trace(j, rng, batch);
   }
+  photons.deposits = true;
   return (batch.collisions + batch.null_collisions) / double(n);
 }
 
