@@ -327,6 +327,15 @@ struct ScatterPhotons {
     const double u = rng.uniform();
     return s.deposit_midpoints ? 0.5 : u;
   }
+  // deposit_flight of the flight x + t w, t in [0, t_end], with power, into the batch's tally (block); its
+  // offset is drawn whether or not the flight is deposited (deposits), so the walks are the same either way.
+  void deposit(PhotonBatch& batch, const TallyBlock& block, const Vec3& x, const Vec3& w, double t_end,
+               const Rgb& power, CornerUniforms* corners, Rng& rng) const {
+    const double u = offset(rng);
+    if (deposits)
+      deposit_flight(batch.tally.data(), block, grid, live, bands, x, w, t_end, power, s.deposit_step, u,
+                     corners);
+  }
   bool reflect(const SurfaceHit& hit, Vec3* w, int c, double* weight, int* order, Rng& rng) const;
   bool bounce(const SurfaceHit& hit, Vec3* w, double* factor, Rng& rng) const;
   bool scatter(const Vec3& xc, Vec3* w, int c, double* weight, int* order, Rng& rng,
@@ -395,11 +404,7 @@ void ScatterPhotons::trace(size_t j, Rng& rng, PhotonBatch& batch) const {
         return real;
       },
       [&](const Vec3& x, const Vec3& w, double t_end) {
-        if (order < first_order) return;
-        const double u = offset(rng);  // drawn whether or not the flight is deposited (deposits)
-        if (deposits)
-          deposit_flight(batch.tally.data(), block, grid, live, bands, x, w, t_end, power * weight,
-                         s.deposit_step, u, corners);
+        if (order >= first_order) deposit(batch, block, x, w, t_end, power * weight, corners, rng);
       },
       [&](const Vec3& xc, Vec3* w) { return scatter(xc, w, c, &weight, &order, rng, batch); },
       [&](const SurfaceHit& hit, Vec3* w) { return reflect(hit, w, c, &weight, &order, rng); });
@@ -502,12 +507,8 @@ void ScatterPhotons::trace_hero(const Photon& ph, int hero, const Rgb& share, co
   // collision ends a segment, deposited with the weight it had (weighting the whole flight by the
   // weight at its end biases the channels: the denser ones ~10 % low in the test's sphere).
   Vec3 seg = ph.x;  // where the current segment starts (on the current flight)
-  const auto deposit = [&](const Vec3& w, double len) {
-    if (order < first_order) return;
-    const double u = offset(rng);  // drawn whether or not the flight is deposited (deposits)
-    if (deposits)
-      deposit_flight(batch.tally.data(), block, grid, live, bands, seg, w, len, ph.power * walk.weight(),
-                     s.deposit_step, u, corners);
+  const auto deposit_segment = [&](const Vec3& w, double len) {
+    if (order >= first_order) deposit(batch, block, seg, w, len, ph.power * walk.weight(), corners, rng);
   };
   Vec3 dir = ph.w;  // the current flight's direction
   walk_photon(
@@ -519,7 +520,7 @@ void ScatterPhotons::trace_hero(const Photon& ph, int hero, const Rgb& share, co
         NIMBUS_DCHECK(max_component(walk.sigma) <= maj * (1.0 + 1e-9) && min_component(walk.sigma) >= 0.0);
         if (rng.uniform() * maj < walk.sigma[walk.c]) return true;
         batch.null_collisions += 1.0;
-        deposit(dir, (p - seg).length());
+        deposit_segment(dir, (p - seg).length());
         seg = p;
         const Rgb null_density(std::max(0.0, maj - walk.sigma.x), std::max(0.0, maj - walk.sigma.y),
                                std::max(0.0, maj - walk.sigma.z));
@@ -528,7 +529,7 @@ void ScatterPhotons::trace_hero(const Photon& ph, int hero, const Rgb& share, co
       },
       [&](const Vec3& x, const Vec3& w, double t_end) {
         // The flight's last segment (t_end infinite: the photon leaves; deposit_flight clips it).
-        deposit(w, t_end - (seg - x).length());
+        deposit_segment(w, t_end - (seg - x).length());
       },
       [&](const Vec3& xc, Vec3* w) {
         if (!scatter_hero(xc, w, walk, &order, rng, batch)) return false;
