@@ -245,8 +245,9 @@ bool camera_in_forward_peak(const SceneContext& ctx, const Light& light, double 
 }
 }  // namespace
 
-// "auto" beam-grid photons, per light: 2^15, and 2^15 sqrt(pixels / 128^2) (at most 8 times 2^15) for a
-// directional or point light whose forward peak the camera looks into (camera_in_forward_peak). The beam
+// "auto" beam-grid photons, per light: 2^13 sqrt(pixels / 128^2), at most 2^15, and 2^15 sqrt(pixels / 128^2)
+// (at most 8 times 2^15) for a directional or point light whose forward peak the camera looks into
+// (camera_in_forward_peak). The beam
 // grid's noise reaches the image through the peak-only light (eq. D7, second term), which leaves a peak
 // scatter within the cut angle theta_c of the light's direction of travel: it is most of a backlit medium's
 // rim and next to nothing where the camera sees the light from the side. Measured at 512 x 512
@@ -262,8 +263,13 @@ bool camera_in_forward_peak(const SceneContext& ctx, const Light& light, double 
 // and 0.85x on the r = 2 one (0.89), but 1.08x on the side-lit r = 10 sphere (4.4) and 1.09x on the box (3.8),
 // and 1.03x on the thin Disney cloud (0.82 real and 0.87 null collisions per photon: 1.69; its error did not
 // move), which stays below the threshold; at 128 x 128 the count stays 2^15. Where no medium has a peak (an
-// isotropic medium, f = 0): none.
+// isotropic medium, f = 0): none. The lights of dense media seen from the side take 2^13 at 128 x 128: their
+// beam grid is most of its cost fixed and its noise a small part of the error (docs/benchmarks.md, "Beam
+// photons seen from the side"; 6 seeds): 0.87-0.95x error^2 x CPU on the side- and front-lit r = 10, double HG
+// and r = 50 spheres, the box and both Disney clouds, means unchanged; at 512 x 512 2^13 and 2^14 were no
+// better than 2^15 (the set-up is a smaller share there), which the sqrt(pixels) growth reaches.
 constexpr double kThinCollisions = 1.2;
+constexpr int kAutoSideBeamPhotons = 1 << 13;
 std::vector<int> auto_beam_photons(const SceneContext& ctx, double cut_angle,
                                    std::optional<double> collisions) {
   const double scale = std::min(8.0, pixel_scale(ctx.camera));
@@ -275,7 +281,7 @@ std::vector<int> auto_beam_photons(const SceneContext& ctx, double cut_angle,
   for (const Light& light : ctx.lights)
     n.push_back(thin || camera_in_forward_peak(ctx, light, cut_angle)
                     ? int(std::round(kAutoBeamPhotons * scale))
-                    : kAutoBeamPhotons);
+                    : int(std::round(std::min(double(kAutoBeamPhotons), kAutoSideBeamPhotons * scale))));
   return n;
 }
 

@@ -160,8 +160,8 @@ TEST(RenderSettings, AutoBeamPhotonsFollowThePixelsInThinMedia) {
   crop.region = Region{128, 128, 129, 129};
   EXPECT_EQ(render(scene(0.3, 256, "\"auto\"", sun), crop).settings["beam_photons"], 1 << 16);
   EXPECT_EQ(render(scene(0.3, 8, "\"auto\"", sun)).settings["beam_photons"], 1 << 15);
-  EXPECT_EQ(render(scene(10.0, 256, "\"auto\"", sun), crop).settings["beam_photons"], 1 << 15);
-  EXPECT_EQ(render(scene(0.3, 256, "4096", sun), crop).settings["beam_photons"], 1 << 15);
+  EXPECT_EQ(render(scene(10.0, 256, "\"auto\"", sun), crop).settings["beam_photons"], 1 << 14);
+  EXPECT_EQ(render(scene(0.3, 256, "4096", sun), crop).settings["beam_photons"], 1 << 14);
   const std::string spot =
       R"({"type": "spot", "position": [0.5, 6, 0], "direction": [0, -1, 0], "intensity": 10.0, "cone_angle_deg": 60})";
   const RenderResult first = render(scene(0.3, 256, "\"auto\"", sun + ", " + spot), crop);
@@ -175,12 +175,13 @@ TEST(RenderSettings, AutoBeamPhotonsFollowThePixelsInThinMedia) {
       0);
 }
 
-// "auto" beam photons: 2^15 per light, and 2^15 sqrt(pixels / 128^2) for a light whose forward peak the
-// camera looks into (its light travels towards the camera within the peak's cut angle, about 37 degrees
-// for HG 0.8, plus the media's size on the image): a crop of a 256 x 256 image of a backlit sphere
-// traces 2^16 (2048 x 2048: 2^18, the most), the 8 x 6 image, a side-lit sphere and a spot light (which the
-// beam grid does not trace) 2^15, a camera inside the media 2^16 for any light; with lights of both kinds the
-// header says "auto" (and renders the same image again); a count given is kept.
+// "auto" beam photons: 2^13 sqrt(pixels / 128^2) per light (at most 2^15), and 2^15 sqrt(pixels / 128^2) for a
+// light whose forward peak the camera looks into (its light travels towards the camera within the peak's cut
+// angle, about 37 degrees for HG 0.8, plus the media's size on the image): a crop of a 256 x 256 image of a
+// backlit sphere traces 2^16 (2048 x 2048: 2^18, the most) and the 8 x 8 image 2^15; a side-lit sphere and a
+// spot light (which the beam grid does not trace) 2^14 (8 x 8: 2^13, 2048 x 2048: 2^15, the most), a camera
+// inside the media 2^16 for any light; with lights of both kinds the header says "auto" (and renders the same
+// image again); a count given is kept.
 TEST(RenderSettings, AutoBeamPhotonsFollowThePixelsWhereTheCameraLooksIntoTheForwardPeak) {
   const auto scene = [](const std::string& lights, int size) {
     return test::scene_from_json("{" + test::camera_json(size, size) + R"(,
@@ -198,8 +199,9 @@ TEST(RenderSettings, AutoBeamPhotonsFollowThePixelsWhereTheCameraLooksIntoTheFor
   EXPECT_EQ(render(scene(back, 256), crop).settings["beam_photons"], 1 << 16);
   EXPECT_EQ(render(scene(behind, 256), crop).settings["beam_photons"], 1 << 16);
   EXPECT_EQ(render(scene(back, 8)).settings["beam_photons"], 1 << 15);
-  EXPECT_EQ(render(scene(side, 256), crop).settings["beam_photons"], 1 << 15);
-  EXPECT_EQ(render(scene(beside, 256), crop).settings["beam_photons"], 1 << 15);
+  EXPECT_EQ(render(scene(side, 256), crop).settings["beam_photons"], 1 << 14);
+  EXPECT_EQ(render(scene(side, 8)).settings["beam_photons"], 1 << 13);
+  EXPECT_EQ(render(scene(beside, 256), crop).settings["beam_photons"], 1 << 14);
   const RenderResult both = render(scene(back + "," + side, 256), crop);
   EXPECT_EQ(both.settings["beam_photons"], "auto");
   const Scene again = parse_scene(nlohmann::json::parse(meta(both, "nimbus/scene")), "header", ".");
@@ -209,11 +211,12 @@ TEST(RenderSettings, AutoBeamPhotonsFollowThePixelsWhereTheCameraLooksIntoTheFor
             0);
   crop.region = Region{1000, 1000, 1001, 1001};
   EXPECT_EQ(render(scene(back, 2048), crop).settings["beam_photons"], 1 << 18);  // at most 8 x 2^15
+  EXPECT_EQ(render(scene(side, 2048), crop).settings["beam_photons"], 1 << 15);  // at most 2^15
   crop.region = Region{128, 128, 129, 129};
   const std::string spot =
       R"({"type": "spot", "position": [0.5, 6, 0], "direction": [0, -1, 0], "intensity": 10.0, "cone_angle_deg": 60})";
   EXPECT_EQ(render(scene(spot, 256), crop).settings["beam_photons"],
-            1 << 15);  // the beam grid traces no spot
+            1 << 14);  // the beam grid traces no spot
   // A camera inside the media's bounds may look anywhere: every light is counted as seen along its peak.
   Scene inside = scene(side, 256);
   inside.media[0].shape = SphereShape{Vec3(0.0), 8.0};
