@@ -69,7 +69,7 @@ MfsIntegrator::MfsIntegrator(const SceneContext& context, MfsSettings settings, 
     s_.exact_light_transmittance = ctx_.analytic.active() && ctx_.media.count() == 1;
   build_maps();
   if (!s_.scatter_grid_resolution) s_.scatter_grid_resolution = auto_scatter_grid_resolution(ctx_);
-  if (!s_.photons) s_.photons = auto_photons(ctx_.camera);
+  if (!s_.photons) s_.photons = auto_photons(ctx_, cut_angle);
   const std::optional<MajorantGrid> photon_majorants = photon_majorant_grid(ctx_, s_, beam_counts_);
   const MajorantGrid* tracking = photon_majorants ? &*photon_majorants : nullptr;
   std::vector<const PhaseSplit*> splits;  // for the photon grids

@@ -193,23 +193,6 @@ int auto_scatter_grid_bands(const std::vector<const PhaseSplit*>& splits) {
   return 1;
 }
 
-// "auto" scatter-grid photons: 2^18 up to 128 x 128 pixels, then 2^18 sqrt(pixels / 128^2). A grid of N
-// photons costs c N of set-up and leaves a noise a / N in the error^2 beside mfs's bias b^2; the rest of the
-// render costs F (the march, growing with the pixels). (b^2 + a / N) (F + c N) is least at
-// N = sqrt(a F / (b^2 c)), so the count follows the square root of the pixels. Measured at 512 x 512
-// (docs/benchmarks.md, "Photons by image size"): 4 x 2^18 gives 0.70x error^2 x CPU on the Disney cloud and 0.56x on the
-// front-lit r = 10 sphere against 2^18. The full image's pixels, not the spp or a region's: a resumed,
-// cropped or sample-range render traces the same photons as the render in one go. The scatter grid then
-// multiplies this by a factor of its pilot's collisions per photon C, clamp(sqrt(3.4 / C), 1, 4)
-// (ScatterGridSettings::adaptive_photons): a photon's cost c grows with C, and on thin media the grid's
-// noise a is most of the error. The two factors of N multiply (docs/benchmarks.md, "Photons by collisions
-// and image size together").
-constexpr int kAutoPhotons = 1 << 18;
-int auto_photons(const PinholeCamera& camera) {
-  const double n = double(kAutoPhotons) * pixel_scale(camera);
-  return int(std::min(std::round(n), double(1 << 26)));
-}
-
 namespace {
 constexpr int kAutoBeamPhotons = 1 << 15;
 // Whether the camera looks into a directional or point light's forward peak: the angle between the light's
@@ -244,6 +227,32 @@ bool camera_in_forward_peak(const SceneContext& ctx, const Light& light, double 
   return angle(travel, v) <= reach;
 }
 }  // namespace
+
+// "auto" scatter-grid photons: 2^18 up to 128 x 128 pixels, then 2^18 sqrt(pixels / 128^2), and half that where
+// the camera looks into a directional or point light's forward peak. A grid of N photons costs c N of set-up and
+// leaves a noise a / N in the error^2 beside mfs's bias b^2; the rest of the render costs F (the march, growing
+// with the pixels). (b^2 + a / N) (F + c N) is least at N = sqrt(a F / (b^2 c)), so the count follows the square
+// root of the pixels. Measured at 512 x 512 (docs/benchmarks.md, "Photons by image size"): 4 x 2^18 gives 0.70x
+// error^2 x CPU on the Disney cloud and 0.56x on the front-lit r = 10 sphere against 2^18. Looking into the
+// peak, the image is mostly the peak-carried light (the beam grid's) and the rim, and the wide light's noise a
+// is a smaller part of it (docs/benchmarks.md, "Scatter photons where the camera looks into the peak"): 2^17 at
+// 128 x 128 gives 0.76x error^2 x CPU on the backlit r = 10 sphere and 0.73x on the r = 20 one, 0.99x on the
+// backlit chromatic box; 2^19 at 512 x 512 0.87x on the backlit r = 10 sphere. The full image's pixels, not the
+// spp or a region's: a resumed, cropped or sample-range render traces the same photons as the render in one
+// go. The scatter grid then multiplies this by a factor of its pilot's collisions per photon C,
+// clamp(sqrt(3.4 / C), 1, 4) (ScatterGridSettings::adaptive_photons): a photon's cost c grows with C, and on
+// thin media the grid's noise a is most of the error. The two factors of N multiply (docs/benchmarks.md,
+// "Photons by collisions and image size together").
+constexpr int kAutoPhotons = 1 << 18;
+int auto_photons(const SceneContext& ctx, double cut_angle) {
+  double n = double(kAutoPhotons) * pixel_scale(ctx.camera);
+  for (const Light& light : ctx.lights)
+    if (camera_in_forward_peak(ctx, light, cut_angle)) {
+      n *= 0.5;
+      break;
+    }
+  return int(std::min(std::round(n), double(1 << 26)));
+}
 
 // "auto" beam-grid photons, per light: 2^13 sqrt(pixels / 128^2), at most 2^15, and 2^15 sqrt(pixels / 128^2)
 // (at most 8 times 2^15) for a directional or point light whose forward peak the camera looks into

@@ -18,8 +18,9 @@ int auto_scatter_grid_resolution(const SceneContext& ctx);
 // "auto" scatter-grid bands: 1 where every medium scatters isotropically (no peak, and its phase function's
 // moments for l = 1, 2 vanish), else 3.
 int auto_scatter_grid_bands(const std::vector<const PhaseSplit*>& splits);
-// "auto" scatter-grid photons from the whole image's pixels.
-int auto_photons(const PinholeCamera& camera);
+// "auto" scatter-grid photons from the whole image's pixels, halved where the camera looks into a light's
+// forward peak (the widest peak's cut angle [rad]).
+int auto_photons(const SceneContext& ctx, double cut_angle);
 // "auto" beam-grid photons per light, given the widest peak's cut angle [rad] (0: no medium has a peak, and
 // every light gets none).
 std::vector<int> auto_beam_photons(const SceneContext& ctx, double cut_angle,

@@ -140,6 +140,23 @@ TEST(RenderSettings, AutoPhotonsFollowTheMediumsCollisions) {
   EXPECT_EQ(render(settings_sphere_scene(given, 4, 3, 0.3)).settings["photons"], 5000);
 }
 
+// "auto" photons where the camera looks into a light's forward peak: half. The dense sphere above, lit from
+// behind (as in AutoBeamPhotonsFollowThePixelsWhereTheCameraLooksIntoTheForwardPeak), takes 2^17, and
+// 2^18 from the side; the halving follows the light, not the environment beside it.
+TEST(RenderSettings, AutoPhotonsHalfWhereTheCameraLooksIntoTheForwardPeak) {
+  const auto scene = [](const std::string& direction) {
+    return test::scene_from_json("{" + test::camera_json(4, 3) + R"(,
+      "media": [{"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1}, "sigma_s": 9.9, "sigma_a": 0.1,
+                 "phase": {"type": "hg", "g": 0.8}}],
+      "lights": [{"type": "directional", "direction": )" +
+                                 direction + R"(, "irradiance": 1.0},
+                 {"type": "environment", "radiance": 0.2}],
+      "integrator": {"type": "mfs", "spp": 1, "beam_photons": 1024, "scatter_grid_resolution": 8}})");
+  };
+  EXPECT_EQ(render(scene("[0.3, -1, 0.2]")).settings["photons"], 1 << 17);
+  EXPECT_EQ(render(scene("[-1, 0.3, 0.2]")).settings["photons"], 1 << 18);
+}
+
 // "auto" beam photons in thin media (the scatter grid pilot's collisions per photon below 1.2): 2^15
 // sqrt(pixels / 128^2) for every light, seen from the side too. A side-lit sphere of optical radius 0.3
 // traces 2^16 in a crop of a 256 x 256 image and 2^15 at 8 x 6; one of radius 10 (~4 collisions per photon)
