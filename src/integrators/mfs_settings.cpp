@@ -240,7 +240,7 @@ bool camera_in_forward_peak(const SceneContext& ctx, const Light& light, double 
 // backlit chromatic box; 2^19 at 512 x 512 0.87x on the backlit r = 10 sphere. The full image's pixels, not the
 // spp or a region's: a resumed, cropped or sample-range render traces the same photons as the render in one
 // go. The scatter grid then multiplies this by a factor of its pilot's collisions per photon C,
-// clamp(sqrt(3.4 / C), 1, 4) (ScatterGridSettings::adaptive_photons): a photon's cost c grows with C, and on
+// clamp(sqrt(3.4 / C), 1/2, 4) (ScatterGridSettings::adaptive_photons): a photon's cost c grows with C, and on
 // thin media the grid's noise a is most of the error. The two factors of N multiply (docs/benchmarks.md,
 // "Photons by collisions and image size together").
 constexpr int kAutoPhotons = 1 << 18;

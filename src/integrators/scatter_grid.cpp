@@ -647,15 +647,17 @@ std::vector<uint8_t> live_nodes(const NodeGrid& grid, const MajorantGrid& majora
 // it is they that make it dear: the thin Disney cloud (0.82 real collisions per photon) took 2.04 x 2^18
 // photons by its real collisions alone, which cost more than they bought (error^2 x CPU 0.79x with 2^18 at
 // 128 x 128, 1.20x with 2.2 M against 2^20 at 512 x 512; docs/benchmarks.md, "The thin Disney cloud").
+// The factor goes down to 1/2 where photons are dearer still (docs/benchmarks.md, "Photons by collisions in
+// dense media"; 128 x 128, 6 seeds): the Disney cloud (6.9 collisions per photon, real and null) at 0.70 x
+// 2^18 0.87x error^2 x CPU, the r = 50 sphere (21) at 2^17 0.84x and 0.87x; the r = 10 spheres and the box
+// (4.2 to 4.8) at 0.84-0.90 x 2^18 0.97-1.05x.
 constexpr int kPilotPhotons = 2048;
 constexpr double kDenseCollisions = 3.4;
+constexpr double kMinPhotonFactor = 0.5;
 constexpr double kMaxPhotonFactor = 4.0;
 
-// Whether a pilot could change the count: not where settings.photons is already the most it could give.
-bool wants_pilot(const ScatterGridSettings& s) {
-  return s.adaptive_photons > 0 && double(s.photons) < kMaxPhotonFactor * double(s.adaptive_photons) &&
-         s.photons < (1 << 26);
-}
+// Whether a pilot sets the count.
+bool wants_pilot(const ScatterGridSettings& s) { return s.adaptive_photons > 0; }
 
 void ScatterPhotons::split(int photons) {
   first = photon_split(ctx, emission, s, photons, lights, sources, centre, radius);
@@ -679,11 +681,12 @@ double pilot_collisions(ScatterPhotons& photons, size_t tally_size) {
   return (batch.collisions + batch.null_collisions) / double(n);
 }
 
-// max(s.photons, s.adaptive_photons x clamp(sqrt(kDenseCollisions / collisions), 1, kMaxPhotonFactor)).
+// s.adaptive_photons x clamp(sqrt(kDenseCollisions / collisions), kMinPhotonFactor, kMaxPhotonFactor), at most
+// 2^26.
 int adaptive_photon_count(const ScatterGridSettings& s, double collisions) {
-  const double factor =
-      std::clamp(std::sqrt(kDenseCollisions / std::max(collisions, 1e-3)), 1.0, kMaxPhotonFactor);
-  return std::max(s.photons, int(std::min(std::round(double(s.adaptive_photons) * factor), double(1 << 26))));
+  const double factor = std::clamp(std::sqrt(kDenseCollisions / std::max(collisions, 1e-3)), kMinPhotonFactor,
+                                   kMaxPhotonFactor);
+  return int(std::clamp(std::round(double(s.adaptive_photons) * factor), 1.0, double(1 << 26)));
 }
 
 // Whether the photons fly over the exact piece of one constant-density shape (walk_photon's `pieces`: the

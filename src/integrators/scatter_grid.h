@@ -54,11 +54,11 @@ struct ScatterGridSettings {
   int photons = 1 << 18;  // per pass, shared among the lights (see power_share)
   // More photons where they are cheap: when > 0, a pilot of kPilotPhotons (scatter_grid.cpp) counts the
   // photons' collisions per photon C (real and null: the tracking's work), and the grid traces
-  // max(photons, adaptive_photons x clamp(sqrt(kDenseCollisions / C), 1, 4)). A photon's cost grows with C
-  // while on thin media the grid's noise is most of the error, so thin media buy their error with more
-  // photons (docs/benchmarks.md, "Photons by collisions"). `mfs`'s "auto" photons: its image size's count
-  // (auto_photons), so the two factors multiply; 0 for a count given. No pilot where photons >= 4 x
-  // adaptive_photons or 2^26 (it could not raise the count).
+  // adaptive_photons x clamp(sqrt(kDenseCollisions / C), 1/2, 4) instead of `photons`. A photon's cost grows
+  // with C while on thin media the grid's noise is most of the error, so thin media buy their error with
+  // more photons and very dense ones with fewer (docs/benchmarks.md, "Photons by collisions" and "Photons by
+  // collisions in dense media"). `mfs`'s "auto" photons: its image size's count (auto_photons), so the two
+  // factors multiply; 0 for a count given.
   int adaptive_photons = 0;
   // Chromatic media: one photon pass per channel, each with that channel's coefficients (true), or one
   // pass of hero-channel photons carrying all three (false; scatter_grid.cpp's HeroWalk). Grey media
