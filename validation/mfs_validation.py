@@ -69,10 +69,12 @@ def hg(g):
     return {"type": "hg", "g": g}
 
 
-def cloud(sigma_s):
+def cloud(sigma_s, sun=None):
     s = json.load(open(os.path.join(ROOT, "scenes", "disney_cloud.json")))
     s["camera"]["width"], s["camera"]["height"] = 64, 48
     s["media"][0]["sigma_s"] = sigma_s
+    if sun:  # the sun's direction of travel (the scene's: [-0.75, -0.3, -0.55], from the side and above)
+        s["lights"][0]["direction"] = sun
     return s, os.path.join(ROOT, "scenes"), 2048
 
 
@@ -91,6 +93,7 @@ def suite():
         "sphere_r50_a0.9999_hg0.85_side": homogeneous("sphere", 50, 0.9999, hg(0.85), SIDE, res=32, ref_spp=512),
         "disney_cloud": cloud(0.2),
         "disney_cloud_thin": cloud(0.05),
+        "disney_cloud_back": cloud(0.2, sun=[0.25, -0.9, -0.35]),  # the sun behind the cloud: its silver lining
     }
 
 
@@ -160,7 +163,8 @@ OCTAVE_SPP = [1, 4]
 PT_SPP = [4, 16, 64, 256]  # uniform path tracing
 PT_NOISE = [0.2, 0.1, 0.05]  # adaptive path tracing, render --noise E
 REF_SPP_128 = {"sphere_r10_a0.99_hg0.85_back": 4096, "sphere_r20_a0.9999_hg0.95_back": 2048,
-               "sphere_r50_a0.9999_hg0.85_side": 1024, "disney_cloud": 512, "disney_cloud_thin": 1024}
+               "sphere_r50_a0.9999_hg0.85_side": 1024, "disney_cloud": 512, "disney_cloud_thin": 1024,
+               "disney_cloud_back": 1024}
 
 
 def uniform_fit(runs, noise):
