@@ -226,6 +226,12 @@ bool camera_in_forward_peak(const SceneContext& ctx, const Light& light, double 
   }
   return angle(travel, v) <= reach;
 }
+
+// Whether the camera looks into any light's forward peak (camera_in_forward_peak).
+bool camera_in_any_forward_peak(const SceneContext& ctx, double cut_angle) {
+  return std::any_of(ctx.lights.begin(), ctx.lights.end(),
+                     [&](const Light& light) { return camera_in_forward_peak(ctx, light, cut_angle); });
+}
 }  // namespace
 
 // "auto" scatter-grid photons: 2^18 up to 128 x 128 pixels, then 2^18 sqrt(pixels / 128^2), and half that where
@@ -245,12 +251,8 @@ bool camera_in_forward_peak(const SceneContext& ctx, const Light& light, double 
 // "Photons by collisions and image size together").
 constexpr int kAutoPhotons = 1 << 18;
 int auto_photons(const SceneContext& ctx, double cut_angle) {
-  double n = double(kAutoPhotons) * pixel_scale(ctx.camera);
-  for (const Light& light : ctx.lights)
-    if (camera_in_forward_peak(ctx, light, cut_angle)) {
-      n *= 0.5;
-      break;
-    }
+  const double half = camera_in_any_forward_peak(ctx, cut_angle) ? 0.5 : 1.0;
+  const double n = double(kAutoPhotons) * pixel_scale(ctx.camera) * half;
   return int(std::min(std::round(n), double(1 << 26)));
 }
 
@@ -302,9 +304,8 @@ std::vector<int> auto_beam_photons(const SceneContext& ctx, double cut_angle,
 // and more samples there buy nothing (docs/benchmarks.md, "Samples at the outlines"). The full image's
 // camera, as auto_beam_photons.
 int auto_edge_samples(const SceneContext& ctx, double cut_angle) {
-  for (const Light& light : ctx.lights)
-    if (camera_in_forward_peak(ctx, light, cut_angle))
-      return int(std::clamp(std::round(64.0 / pixel_scale(ctx.camera)), 16.0, 64.0));
+  if (camera_in_any_forward_peak(ctx, cut_angle))
+    return int(std::clamp(std::round(64.0 / pixel_scale(ctx.camera)), 16.0, 64.0));
   return 16;
 }
 
