@@ -62,12 +62,14 @@ namespace {
 // channels would be the same numbers), in this order: traced, straight; with the spread (beam_spread
 // "traced"), traced x (1 - cosine) and straight x the straight model's 1 - mean cosine; with a camera
 // (peak_toward), traced x P_peak towards the camera; with the wide factor towards the camera (wide_toward),
-// traced x P_wide towards the camera and traced x the straight model's wide_eff there.
+// traced x P_wide towards the camera and traced x the straight model's wide_eff there; last, traced and
+// straight again, not divided by the straight model's T_wide (their ratio is BeamGrid::lookup's bound).
 struct Blocks {
   bool spread, pk, wide = false;
-  int count() const { return 2 + (spread ? 2 : 0) + (pk ? 1 : 0) + (wide ? 2 : 0); }
+  int count() const { return plain_block() + 2; }
   int pk_block() const { return spread ? 4 : 2; }
   int wide_block() const { return pk_block() + (pk ? 1 : 0); }
+  int plain_block() const { return wide_block() + (wide ? 2 : 0); }
 };
 constexpr double kR2a1 = 0.75487766624669276, kR2a2 = 0.56984029099805327;  // the R2 sequence
 constexpr double kRoulette = 0.05;  // roulette below this ratio of weight to T_wide
@@ -94,25 +96,29 @@ Rgb straight_mean_cosine(const Rgb& full, const Rgb& reduced, double one_minus_c
 enum class Columns { traced, straight, both };
 
 // Adds v (channel ch of `channels`) with trilinear weights st to the tally: to the straight column (and
-// times spread_s its spread column), to the traced one (and times spread its spread column), or to both;
+// times spread_s its spread column, times tw its plain column), to the traced one (and times spread its
+// spread column, times tw its plain column), or to both;
 // with a P_peak block also the traced v times pk (P_peak towards the camera); with the wide blocks the
 // traced v times pw (P_wide towards the camera) and times pm (the straight model's wide factor).
 struct CameraFactors {
   double pk = 0.0, pw = 0.0, pm = 0.0;
 };
-void splat(float* tally, int channels, Blocks b, const TrilinearStencil& st, int ch, double v, double spread,
-           double spread_s, const CameraFactors& cf, Columns to) {
+void splat(float* tally, int channels, Blocks b, const TrilinearStencil& st, int ch, double v, double tw,
+           double spread, double spread_s, const CameraFactors& cf, Columns to) {
   const int stride = channels * b.count();
+  const int plain = b.plain_block() * channels;
   for (int j = 0; j < 8; ++j)
     if (st.weight[j] > 0.0) {
       float* node = &tally[st.node[j] * stride + ch];
       const double x = st.weight[j] * v;
       if (to != Columns::traced) {
         node[channels] += float(x);
+        node[plain + channels] += float(x * tw);
         if (b.spread) node[3 * channels] += float(x * spread_s);
       }
       if (to != Columns::straight) {
         node[0] += float(x);
+        node[plain] += float(x * tw);
         if (b.spread) node[2 * channels] += float(x * spread);
         if (b.pk) node[b.pk_block() * channels] += float(x * cf.pk);
         if (b.wide) {
@@ -184,6 +190,7 @@ void drop_unmatched(FloatArray* v, int channels, Blocks b) {
       if (b.spread) node[2 * channels + c] = 0.0f;
       if (b.pk) node[b.pk_block() * channels + c] = 0.0f;
       if (b.wide) node[b.wide_block() * channels + c] = node[(b.wide_block() + 1) * channels + c] = 0.0f;
+      node[b.plain_block() * channels + c] = node[(b.plain_block() + 1) * channels + c] = 0.0f;
     }
   }
 }
@@ -337,7 +344,7 @@ void BeamPhotons::sample(float* tally, const Vec3& q, const Vec3& w, double dl, 
     if (wide_wanted)
       cf.pm = splits[0]->wide_eff(
           tf[ch] > 1e-30 ? std::max(0.0, std::log(tw[ch] / tf[ch])) : PhaseSplit::kTauMax, mu_s);
-    splat(tally, channels, blocks, st, ch, v, spread, spread_s[ch], cf, to);
+    splat(tally, channels, blocks, st, ch, v, tw[ch], spread, spread_s[ch], cf, to);
   }
 }
 
@@ -544,12 +551,14 @@ bool BeamGrid::lookup(size_t light, const Vec3& p, const TrilinearStencil& st, c
   const Blocks blocks{.spread = spread_, .pk = with_camera_, .wide = with_wide_};
   const bool spread = spread_ && mean_cosine, pk_wanted = with_camera_ && peak_toward;
   const bool wide_wanted = with_wide_ && wide_ratio;
-  Rgb r(0.0), straight(0.0), sp(0.0), sp_s(0.0), pk(0.0), pw(0.0), pm(0.0);
+  Rgb r(0.0), straight(0.0), sp(0.0), sp_s(0.0), pk(0.0), pw(0.0), pm(0.0), r_plain(0.0), s_plain(0.0);
   for (int k = 0; k < 8; ++k)
     for (int c = 0; c < n; ++c) {
       const float* node = &v[st.node[k] * size_t(stride_) + c];
       r[c] += st.weight[k] * node[0];
       straight[c] += st.weight[k] * node[n];
+      r_plain[c] += st.weight[k] * node[blocks.plain_block() * n];
+      s_plain[c] += st.weight[k] * node[(blocks.plain_block() + 1) * n];
       if (spread) {
         sp[c] += st.weight[k] * node[2 * n];
         sp_s[c] += st.weight[k] * node[3 * n];
@@ -565,6 +574,11 @@ bool BeamGrid::lookup(size_t light, const Vec3& p, const TrilinearStencil& st, c
       mean_cosine ? Rgb(1.0) - straight_mean_cosine(T_light, T_wide, one_minus_chi1_) : Rgb(0.0);
   for (int c = 0; c < n; ++c) {
     (*factor)[c] = straight[c] > 0.0 ? r[c] / straight[c] : 1.0;
+    // At most the ratio of the plain tallies: R is a mean of traced / straight over the nodes' deposits, and
+    // where the straight model's T_wide falls by orders of magnitude within a cell (a dense cloud's shadow
+    // edges) its darkest samples would set R for the whole cell; T_wide R then lit the cell's brighter parts
+    // with more light than its photons carried there.
+    if (s_plain[c] > 0.0) (*factor)[c] = std::min((*factor)[c], r_plain[c] / s_plain[c]);
     if (mean_cosine) {
       double s = model[c];
       if (spread && r[c] > 0.0)

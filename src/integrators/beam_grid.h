@@ -23,7 +23,11 @@
 // minus the model's as tallied. Where the spread changes faster than the nodes resolve (the lit side of a
 // dense medium, where it grows from 0 at the surface) the model's exact value at p carries the change and
 // the nodes only the difference (eq. D9b): a cell-averaged spread made the lit rim of a backlit sphere too
-// dark. `mfs` multiplies T_wide by R. Deposits in cells with no
+// dark. `mfs` multiplies T_wide by R. Two more columns tally the traced and the straight deposits without
+// the division by the model, and R is at most their ratio: where the model's T_wide falls by orders of
+// magnitude within a cell (a dense cloud's shadow edges, a smoke's filaments) the mean of traced / model
+// is set by the cell's darkest samples, and T_wide R would light its brighter parts beyond what its photons
+// carried there (docs/validation/render.md, "A dense cloud"). Deposits in cells with no
 // medium in or next to them are skipped (nothing there is read where a medium scatters), so far from
 // the media (the grid's padding, the empty space and the shadows within its bounds) R is incomplete.
 #pragma once
@@ -62,10 +66,10 @@ class BeamGrid {
            int resolution, uint64_t seed, bool spread, const Vec3* camera = nullptr,
            const MajorantGrid* majorants = nullptr, bool skip_idle = true, int smoothing = 0,
            BeamCameraTallies tallies = {});
-  // R for light `light` at p (trilinear between nodes) and, if mean_cosine is not null, the peak-only
-  // light's mean cosine to the straight direction from the light, given the straight model's T_light and
-  // T_wide at p (the spread's control variate; a grid without `spread`: the straight model's); false
-  // (nothing written) outside the grid and for other lights.
+  // R for light `light` at p (trilinear between nodes; at most the plain tallies' ratio there) and, if
+  // mean_cosine is not null, the peak-only light's mean cosine to the straight direction from the light,
+  // given the straight model's T_light and T_wide at p (the spread's control variate; a grid without
+  // `spread`: the straight model's); false (nothing written) outside the grid and for other lights.
   // With a camera, peak_toward (if not null) gets the traced beam's P_peak (medium 0's) towards the camera,
   // averaged over its directions: the angular factor of the forward peak alone (eq. D7's peak_eff).
   // With the wide tallies, wide_ratio (if not null) gets the traced beam's P_wide towards the camera over
