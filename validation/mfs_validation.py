@@ -94,6 +94,7 @@ def suite():
         "disney_cloud": cloud(0.2),
         "disney_cloud_thin": cloud(0.05),
         "disney_cloud_back": cloud(0.2, sun=[0.25, -0.9, -0.35]),  # the sun behind the cloud: its silver lining
+        "disney_cloud_dense": cloud(1.0),  # five times as dense: shadow edges sharper than the beam grid's cells
     }
 
 
@@ -164,7 +165,7 @@ PT_SPP = [4, 16, 64, 256]  # uniform path tracing
 PT_NOISE = [0.2, 0.1, 0.05]  # adaptive path tracing, render --noise E
 REF_SPP_128 = {"sphere_r10_a0.99_hg0.85_back": 4096, "sphere_r20_a0.9999_hg0.95_back": 2048,
                "sphere_r50_a0.9999_hg0.85_side": 1024, "disney_cloud": 512, "disney_cloud_thin": 1024,
-               "disney_cloud_back": 1024}
+               "disney_cloud_back": 1024, "disney_cloud_dense": 1024}
 
 
 def uniform_fit(runs, noise):
