@@ -140,7 +140,9 @@ struct LightBeam {
 // Disney cloud. R = traced / straight is a ratio of two tallies, and in a medium of thin dense filaments
 // (the smoke plume) a node's straight tally can be nearly empty: its photons' midpoint-rule loss fell
 // far below the shadow map's where a deposit sample hit a dense voxel. R then reached 10^6 and T_wide R
-// 10^5 (fireflies of 400x the pixel around them). The bound changes no image of the suite.
+// 10^5 (fireflies of 400x the pixel around them). The bound changes no image of the suite. (The beam grid
+// bounds R itself by its plain tallies' ratio (BeamGrid::lookup), which keeps the smoke's and a dense cloud's
+// T_wide R near what their photons carried; this bound stays as the last guard.)
 inline constexpr double kMaxPeakTransmittance = 2.0;
 LightBeam peak_only_beam(const Rgb& T_light, const Rgb& T_wide, bool traced, const Rgb& R,
                          const Rgb* mean_cos, const std::vector<double>& peak_moments, double theta2,
