@@ -444,7 +444,7 @@ bool BeamPhotons::scatter(const Vec3& xc, Vec3* w, BeamWalk& walk, Rng& rng, Pho
     if (rng.uniform() >= keep) return false;
     walk.weight *= 1.0 / keep;
   }
-  ctx.media.eval(xc, &walk.mp);
+  // walk.mp holds the media's values at xc: the tentative collision that made this scatter real looked them up.
   const ScatteringShares shares =
       scattering_shares(walk.mp, ctx.media.count(), c, [&](int i) { return peak_fraction[i]; });
   if (!(shares.sum > 0.0)) return false;

@@ -338,8 +338,10 @@ struct ScatterPhotons {
   }
   bool reflect(const SurfaceHit& hit, Vec3* w, int c, double* weight, int* order, Rng& rng) const;
   bool bounce(const SurfaceHit& hit, Vec3* w, double* factor, Rng& rng) const;
-  bool scatter(const Vec3& xc, Vec3* w, int c, double* weight, int* order, Rng& rng,
-               PhotonBatch& batch) const;
+  // at_xc: the media's values at xc where the walk's tentative collision there already found them (else
+  // null: looked up here).
+  bool scatter(const Vec3& xc, Vec3* w, int c, double* weight, int* order, Rng& rng, PhotonBatch& batch,
+               const MediumPoint* at_xc = nullptr) const;
   // The new direction after a real collision in medium m (weighted and survived); false ends the photon.
   bool turn(int m, Vec3* w, int* order, Rng& rng, PhotonBatch& batch) const;
   // Hero-channel photons of chromatic media (HeroWalk).
@@ -348,6 +350,9 @@ struct ScatterPhotons {
   }
   void trace_hero(const Photon& ph, int hero, const Rgb& share, const TallyBlock& block, int first_order,
                   CornerUniforms* corners, Rng& rng, PhotonBatch& batch) const;
+  // A photon of grey media (RGB power) or of channel c's pass (that channel's power only).
+  void trace_channel(const Photon& ph, int c, const TallyBlock& block, int first_order,
+                     CornerUniforms* corners, Rng& rng, PhotonBatch& batch) const;
   bool scatter_hero(const Vec3& xc, Vec3* w, HeroWalk& walk, int* order, Rng& rng, PhotonBatch& batch) const;
 };
 
@@ -386,6 +391,11 @@ void ScatterPhotons::trace(size_t j, Rng& rng, PhotonBatch& batch) const {
     trace_hero(ph, int(i % 3), share, block, first_order, corners, rng, batch);
     return;
   }
+  trace_channel(ph, c, block, first_order, corners, rng, batch);
+}
+
+void ScatterPhotons::trace_channel(const Photon& ph, int c, const TallyBlock& block, int first_order,
+                                   CornerUniforms* corners, Rng& rng, PhotonBatch& batch) const {
   Rgb power = ph.power;
   if (!grey)
     for (int k = 0; k < 3; ++k)
@@ -393,12 +403,21 @@ void ScatterPhotons::trace(size_t j, Rng& rng, PhotonBatch& batch) const {
   if (max_component(power) <= 0.0 || !(ph.weight > 0.0)) return;
   double weight = ph.weight;
   int order = 0;  // wide scatters so far
+  // The media's values at the last tentative collision, when it looked them up: a real one scatters there
+  // next (walk_photon), and reads them instead of looking the density up again (the same values).
+  MediumPoint at_collision;
+  bool known = false;
+  const bool reduced = !s.exact_transport && !peak_fraction.empty();
   walk_photon(
       ctx, s.majorants ? *s.majorants : ctx.majorants, ph.x, ph.w, majorant_scale, rng, &batch.collisions,
       [&](const Vec3& p, double maj) {
         // Over one grey constant-density shape's exact piece every tentative collision is real (sigma =
         // maj): the uniform is drawn as for any other, the density is not looked up (exact_pieces).
-        const double sigma = exact_pieces ? maj : extinction(p)[c];
+        known = !exact_pieces && reduced;
+        if (known) ctx.media.eval(p, &at_collision);
+        const double sigma = exact_pieces ? maj
+                             : known      ? reduced_sigma_t(at_collision, peak_fraction)[c]
+                                          : extinction(p)[c];
         const bool real = rng.uniform() * maj < sigma;
         batch.null_collisions += real ? 0.0 : 1.0;
         return real;
@@ -406,7 +425,9 @@ void ScatterPhotons::trace(size_t j, Rng& rng, PhotonBatch& batch) const {
       [&](const Vec3& x, const Vec3& w, double t_end) {
         if (order >= first_order) deposit(batch, block, x, w, t_end, power * weight, corners, rng);
       },
-      [&](const Vec3& xc, Vec3* w) { return scatter(xc, w, c, &weight, &order, rng, batch); },
+      [&](const Vec3& xc, Vec3* w) {
+        return scatter(xc, w, c, &weight, &order, rng, batch, known ? &at_collision : nullptr);
+      },
       [&](const SurfaceHit& hit, Vec3* w) { return reflect(hit, w, c, &weight, &order, rng); });
 }
 
@@ -452,9 +473,10 @@ bool ScatterPhotons::reflect(const SurfaceHit& hit, Vec3* w, int c, double* weig
 // A real collision at xc of a photon of channel c: albedo weight, roulette, medium, direction.
 // False ends the photon.
 bool ScatterPhotons::scatter(const Vec3& xc, Vec3* w, int c, double* weight, int* order, Rng& rng,
-                             PhotonBatch& batch) const {
-  MediumPoint mp;
-  ctx.media.eval(xc, &mp);
+                             PhotonBatch& batch, const MediumPoint* at_xc) const {
+  MediumPoint looked_up;
+  if (!at_xc) ctx.media.eval(xc, &looked_up);
+  const MediumPoint& mp = at_xc ? *at_xc : looked_up;
   const ScatteringShares shares = scattering_shares(
       mp, ctx.media.count(), c, [&](int i) { return s.exact_transport ? 1.0 : 1.0 - peak_fraction[i]; });
   const double sigma = mp.sigma_a[c] + shares.sum;

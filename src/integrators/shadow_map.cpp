@@ -16,6 +16,10 @@ Rgb reduced_sigma_t(const SceneMedia& media, const Vec3& p, const std::vector<do
   if (peak_fraction.empty()) return media.sigma_t(p);
   MediumPoint mp;
   media.eval(p, &mp);
+  return reduced_sigma_t(mp, peak_fraction);
+}
+
+Rgb reduced_sigma_t(const MediumPoint& mp, const std::vector<double>& peak_fraction) {
   Rgb s = mp.sigma_t();
   for (int i = 0; i < mp.count && i < int(peak_fraction.size()); ++i) s -= mp.sigma_s_i[i] * peak_fraction[i];
   return s;

@@ -22,6 +22,9 @@ namespace nimbus {
 // peak_fraction[i] sigma_s_i (the forward peak of medium i's
 // phase function is not extinction for forward-scattered light; `mfs`). Empty: plain sigma_t.
 Rgb reduced_sigma_t(const SceneMedia& media, const Vec3& p, const std::vector<double>& peak_fraction);
+// The same from the media's values at the point (SceneMedia::eval), for a non-empty peak_fraction: the same
+// arithmetic, so the same bits.
+Rgb reduced_sigma_t(const MediumPoint& mp, const std::vector<double>& peak_fraction);
 
 // Transmittance from p along w over [0, tmax] by a midpoint march with steps of at most tau_step
 // optical depth against the majorant (deterministic; error O(step^2) for smooth media). With
