@@ -404,20 +404,23 @@ void ScatterPhotons::trace_channel(const Photon& ph, int c, const TallyBlock& bl
   double weight = ph.weight;
   int order = 0;  // wide scatters so far
   // The media's values at the last tentative collision, when it looked them up: a real one scatters there
-  // next (walk_photon), and reads them instead of looking the density up again (the same values).
+  // next (walk_photon), and reads them instead of looking the density up again. Its extinction from them
+  // is extinction(p) for one untinted medium bit for bit, and to rounding otherwise (summed per kind of
+  // coefficient rather than per medium). (Not in emitting media, where eval also finds the emission.)
   MediumPoint at_collision;
   bool known = false;
-  const bool reduced = !s.exact_transport && !peak_fraction.empty();
+  const bool from_point = (s.exact_transport || !peak_fraction.empty()) && !ctx.media.emits();
   walk_photon(
       ctx, s.majorants ? *s.majorants : ctx.majorants, ph.x, ph.w, majorant_scale, rng, &batch.collisions,
       [&](const Vec3& p, double maj) {
         // Over one grey constant-density shape's exact piece every tentative collision is real (sigma =
         // maj): the uniform is drawn as for any other, the density is not looked up (exact_pieces).
-        known = !exact_pieces && reduced;
+        known = !exact_pieces && from_point;
         if (known) ctx.media.eval(p, &at_collision);
-        const double sigma = exact_pieces ? maj
-                             : known      ? reduced_sigma_t(at_collision, peak_fraction)[c]
-                                          : extinction(p)[c];
+        const double sigma = exact_pieces        ? maj
+                             : !known            ? extinction(p)[c]
+                             : s.exact_transport ? at_collision.sigma_t()[c]
+                                                 : reduced_sigma_t(at_collision, peak_fraction)[c];
         const bool real = rng.uniform() * maj < sigma;
         batch.null_collisions += real ? 0.0 : 1.0;
         return real;
