@@ -344,9 +344,14 @@ struct ScatterPhotons {
                const MediumPoint* at_xc = nullptr) const;
   // The new direction after a real collision in medium m (weighted and survived); false ends the photon.
   bool turn(int m, Vec3* w, int* order, Rng& rng, PhotonBatch& batch) const;
-  // Hero-channel photons of chromatic media (HeroWalk).
+  // The extinction the photons see at p: the media's own, or reduced by the peaks (similarity transport).
   Rgb extinction(const Vec3& p) const {
     return s.exact_transport ? ctx.media.sigma_t(p) : reduced_sigma_t(ctx.media, p, peak_fraction);
+  }
+  // The same from the media's values at p (SceneMedia::eval; peak_fraction not empty): the same bits for one
+  // untinted medium, equal to rounding otherwise (summed per kind of coefficient rather than per medium).
+  Rgb extinction(const MediumPoint& mp) const {
+    return s.exact_transport ? mp.sigma_t() : reduced_sigma_t(mp, peak_fraction);
   }
   void trace_hero(const Photon& ph, int hero, const Rgb& share, const TallyBlock& block, int first_order,
                   CornerUniforms* corners, Rng& rng, PhotonBatch& batch) const;
@@ -404,9 +409,8 @@ void ScatterPhotons::trace_channel(const Photon& ph, int c, const TallyBlock& bl
   double weight = ph.weight;
   int order = 0;  // wide scatters so far
   // The media's values at the last tentative collision, when it looked them up: a real one scatters there
-  // next (walk_photon), and reads them instead of looking the density up again. Its extinction from them
-  // is extinction(p) for one untinted medium bit for bit, and to rounding otherwise (summed per kind of
-  // coefficient rather than per medium). (Not in emitting media, where eval also finds the emission.)
+  // next (walk_photon), and reads them instead of looking the density up again. (Not in emitting media,
+  // where eval also finds the emission.)
   MediumPoint at_collision;
   bool known = false;
   const bool from_point = (s.exact_transport || !peak_fraction.empty()) && !ctx.media.emits();
@@ -417,10 +421,7 @@ void ScatterPhotons::trace_channel(const Photon& ph, int c, const TallyBlock& bl
         // maj): the uniform is drawn as for any other, the density is not looked up (exact_pieces).
         known = !exact_pieces && from_point;
         if (known) ctx.media.eval(p, &at_collision);
-        const double sigma = exact_pieces        ? maj
-                             : !known            ? extinction(p)[c]
-                             : s.exact_transport ? at_collision.sigma_t()[c]
-                                                 : reduced_sigma_t(at_collision, peak_fraction)[c];
+        const double sigma = exact_pieces ? maj : known ? extinction(at_collision)[c] : extinction(p)[c];
         const bool real = rng.uniform() * maj < sigma;
         batch.null_collisions += real ? 0.0 : 1.0;
         return real;
