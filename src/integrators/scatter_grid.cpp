@@ -358,7 +358,9 @@ struct ScatterPhotons {
   // A photon of grey media (RGB power) or of channel c's pass (that channel's power only).
   void trace_channel(const Photon& ph, int c, const TallyBlock& block, int first_order,
                      CornerUniforms* corners, Rng& rng, PhotonBatch& batch) const;
-  bool scatter_hero(const Vec3& xc, Vec3* w, HeroWalk& walk, int* order, Rng& rng, PhotonBatch& batch) const;
+  // at_xc: as scatter's.
+  bool scatter_hero(const Vec3& xc, Vec3* w, HeroWalk& walk, int* order, Rng& rng, PhotonBatch& batch,
+                    const MediumPoint* at_xc = nullptr) const;
 };
 
 void ScatterPhotons::trace(size_t j, Rng& rng, PhotonBatch& batch) const {
@@ -537,12 +539,16 @@ void ScatterPhotons::trace_hero(const Photon& ph, int hero, const Rgb& share, co
     if (order >= first_order) deposit(batch, block, seg, w, len, ph.power * walk.weight(), corners, rng);
   };
   Vec3 dir = ph.w;  // the current flight's direction
+  // The media's values at the last tentative collision (as trace_channel; not in emitting media).
+  MediumPoint at_collision;
+  const bool from_point = (s.exact_transport || !peak_fraction.empty()) && !ctx.media.emits();
   walk_photon(
       ctx, s.majorants ? *s.majorants : ctx.majorants, ph.x, ph.w, majorant_scale, rng, &batch.collisions,
       [&](const Vec3& p, double maj) {
         // A tentative collision: real with probability sigma_c / maj; a null one weights channel k by
         // (maj - sigma_k) / (maj - sigma_c) and technique j's density likewise.
-        walk.sigma = extinction(p);
+        if (from_point) ctx.media.eval(p, &at_collision);
+        walk.sigma = from_point ? extinction(at_collision) : extinction(p);
         NIMBUS_DCHECK(max_component(walk.sigma) <= maj * (1.0 + 1e-9) && min_component(walk.sigma) >= 0.0);
         if (rng.uniform() * maj < walk.sigma[walk.c]) return true;
         batch.null_collisions += 1.0;
@@ -558,7 +564,8 @@ void ScatterPhotons::trace_hero(const Photon& ph, int hero, const Rgb& share, co
         deposit_segment(w, t_end - (seg - x).length());
       },
       [&](const Vec3& xc, Vec3* w) {
-        if (!scatter_hero(xc, w, walk, &order, rng, batch)) return false;
+        if (!scatter_hero(xc, w, walk, &order, rng, batch, from_point ? &at_collision : nullptr))
+          return false;
         seg = xc, dir = *w;
         return true;
       },
@@ -577,9 +584,10 @@ void ScatterPhotons::trace_hero(const Photon& ph, int hero, const Rgb& share, co
 // A real collision of a hero-channel photon at xc: the medium by the hero's scattering shares, the
 // weights by each channel's scattering in that medium against the hero's density, roulette, direction.
 bool ScatterPhotons::scatter_hero(const Vec3& xc, Vec3* w, HeroWalk& walk, int* order, Rng& rng,
-                                  PhotonBatch& batch) const {
-  MediumPoint mp;
-  ctx.media.eval(xc, &mp);
+                                  PhotonBatch& batch, const MediumPoint* at_xc) const {
+  MediumPoint looked_up;
+  if (!at_xc) ctx.media.eval(xc, &looked_up);
+  const MediumPoint& mp = at_xc ? *at_xc : looked_up;
   const auto kept = [&](int i) { return s.exact_transport ? 1.0 : 1.0 - peak_fraction[i]; };
   ScatteringShares shares[3];
   for (int k = 0; k < 3; ++k) shares[k] = scattering_shares(mp, ctx.media.count(), k, kept);
