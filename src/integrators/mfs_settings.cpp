@@ -178,7 +178,7 @@ int auto_scatter_grid_resolution(const SceneContext& ctx) {
 
 // "auto" scatter-grid bands. The camera side reads the grid's light through the wide part's moments chi_l
 // (blurred by the peak, eq. D12; forward_side "light": the whole phase function's): where every medium's
-// phase function is isotropic and carried without a peak (f = 0, as "auto" gives it: g^2), chi_l is 0 for
+// phase function is isotropic and carried without a peak (f = 0, as "auto" gives it), chi_l is 0 for
 // l >= 1 and one band (the fluence) gives the same image, for a ninth of the floats per photon deposit (the
 // isotropic Cycles-comparison spheres at 128 x 128: 0.78x and 0.80x the CPU with the beam grid off too,
 // their errors unchanged; docs/benchmarks.md, "Isotropic media").

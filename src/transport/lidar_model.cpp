@@ -266,7 +266,7 @@ LidarModelResult lidar_mfs(const LidarSettings& s) {
   const double z_end = depth_at(s, edges.back());
   const int cells = int(std::clamp(4.0 * s.n * z_end / narrow, 200.0, 4000.0));
   if (s.sigma_s > 0.0) {
-    const PhaseSplit split(s.phase, auto_peak_fraction(s.phase), true);
+    const PhaseSplit split(s.phase, g2_peak_fraction(s.phase), true);
     for (int i = 0; z_end > 0.0 && i < cells; ++i)
       scattered_terms(s, split, z_end * i / cells, z_end / cells, slots);
     // Depths beyond the last edge's reach: all of it arrives after the last edge.

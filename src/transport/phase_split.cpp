@@ -155,6 +155,16 @@ void tabulate_lobes(const std::vector<double>& chi_wide, const std::vector<doubl
 }  // namespace
 
 double auto_peak_fraction(const Phase& phase) {
+  // HG: chi_2 = g^2 < g, the same number as ever.
+  if (const auto* hg = std::get_if<HgPhase>(&phase)) return hg->g > 0.0 ? hg->g * hg->g : 0.0;
+  const double g = phase_mean_cosine(phase);
+  if (!(g > 0.0)) return 0.0;
+  // A cap of 64, not 2: the quadrature follows the cap (at 2 a narrow Gauss peak's chi_2 is 0.006 low).
+  const std::vector<double> chi = phase_legendre_moments(phase, 1e-8, 64);
+  return std::clamp(std::min(chi.size() > 2 ? chi[2] : 0.0, g), 0.0, 1.0);
+}
+
+double g2_peak_fraction(const Phase& phase) {
   const double g = phase_mean_cosine(phase);
   return g > 0.0 ? g * g : 0.0;
 }

@@ -23,8 +23,19 @@
 
 namespace nimbus {
 
-// f = g^2 for mean cosine g > 0 (the delta-Eddington fraction), 0 otherwise.
+// The "auto" peak fraction: f = min(chi_2, g) for mean cosine g > 0, 0 otherwise (at most 1; callers cap
+// it). chi_2, the phase function's second Legendre moment, is the delta-Eddington fraction in general
+// form (g^2 for HG, its special case): the part of the phase function whose removal leaves a wide part
+// with little angular structure beyond l = 2, which the scatter grid's l <= 2 harmonics hold. For a
+// double HG with a backward lobe, g^2 left much of the forward lobe in the wide part (the suite's
+// 0.85 HG(0.9) + 0.15 HG(-0.4): f 0.50, wide chi_3 = 0.28, its l <= 2 expansion negative at 90 degrees);
+// chi_2 takes it whole (f 0.705, wide chi_3 = 0.00). The cap at g keeps the wide part's mean cosine
+// from turning negative where a backward lobe is as peaked as the forward one (chi_2 large, g small).
 double auto_peak_fraction(const Phase& phase);
+// f = g^2 for g > 0, else 0: the lidar model's rule (transport/lidar_model.h), validated with it. It has no
+// grid of harmonics, and chi_2 made its double-HG ocean case worse (whole return -9.9 -> -15.5 % against
+// photon Monte Carlo; docs/validation/lidar.md).
+double g2_peak_fraction(const Phase& phase);
 
 class PhaseSplit {
  public:
