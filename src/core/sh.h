@@ -5,6 +5,7 @@
 // depend on the sign convention.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/math.h"
@@ -71,5 +72,45 @@ struct ShBasis {
   double y[kShMaxBands * kShMaxBands];
   ShBasis(const Vec3& w, int bands) { sh_eval(w, bands, y); }
 };
+
+// Y_lm of the axes x, y, z for l <= 1: the l = 1 band of a function, sum_m L_1m Y_1m(w), is a . w with
+// a_i = sum_m L_1m Y_1m(e_i) (whatever the harmonics' sign convention).
+struct ShAxes {
+  double y[3][4];
+  ShAxes() {
+    for (int i = 0; i < 3; ++i) {
+      Vec3 e(0.0);
+      e[i] = 1.0;
+      sh_eval(e, 2, y[i]);
+    }
+  }
+};
+
+// The bands l = 3 .. kShMaxBands - 1 of a function known by its moments Lc for l <= 2 (9 values), extrapolated
+// from a lobe (ScatterGridSettings::lobe_tail): t[l], band l's value at the direction whose harmonics are y
+// (t[0..2] = 0). The function about its l = 1 direction d, band by band f_l P_l(w . d), with
+// f_l = (2l + 1) (f_1 / 3) r^(l - 1) and r = 3 f_2 / (5 f_1) from its bands 1 and 2 at d: exact for a constant
+// plus c HG(r) about d (f_l = (2l + 1) c r^l / (4 pi)). Nothing where f_2 <= 0 (no lobe); r at most 0.95.
+inline void sh_lobe_tail(const double* Lc, const double* y, double t[kShMaxBands]) {
+  static const ShAxes axes;
+  for (int l = 0; l < kShMaxBands; ++l) t[l] = 0.0;
+  Vec3 a;
+  for (int i = 0; i < 3; ++i) a[i] = Lc[1] * axes.y[i][1] + Lc[2] * axes.y[i][2] + Lc[3] * axes.y[i][3];
+  const double f1 = a.length();
+  if (!(f1 > 0.0)) return;
+  double yd[9];
+  sh_eval(a / f1, 3, yd);
+  double f2 = 0.0;
+  for (int h = 4; h < 9; ++h) f2 += Lc[h] * yd[h];
+  const double r = std::min(0.95, 3.0 * f2 / (5.0 * f1));
+  if (!(r > 0.0)) return;
+  const double mu = std::clamp((Lc[1] * y[1] + Lc[2] * y[2] + Lc[3] * y[3]) / f1, -1.0, 1.0);
+  double p_prev = mu, p = 0.5 * (3.0 * mu * mu - 1.0), rl = r * f1 / 3.0;  // P_1, P_2, (f_1 / 3) r^(l - 1)
+  for (int l = 3; l < kShMaxBands; ++l) {
+    const double next = ((2.0 * l - 1.0) * mu * p - (l - 1.0) * p_prev) / l;
+    p_prev = p, p = next, rl *= r;
+    t[l] = (2.0 * l + 1.0) * rl * p;
+  }
+}
 
 }  // namespace nimbus

@@ -448,10 +448,10 @@ Rgb MfsIntegrator::higher_orders(int i, const Vec3& p, const ShBasis& y_out, dou
     return st ? grid_->scattered(p, *st, y_out, chi) : grid_->scattered(p, y_out, chi);
   };
   // forward_side "light": the whole phase function at y, exact camera leg (eq. D12 with D1's moments).
-  if (s_.light_side()) return scattered(whole_phase_moments(split, f, grid_->bands()));
+  if (s_.light_side()) return scattered(whole_phase_moments(split, f, grid_->moments_read()));
   // Camera side: the wide part, its moments blurred by the camera-side peak depth (eqs. D3, D12),
   // optionally read pre-filtered over the camera-side lateral spread (eq. D10).
-  const std::array<Rgb, kShMaxBands> chi = blurred_wide_moments(split, tau_p, grid_->bands());
+  const std::array<Rgb, kShMaxBands> chi = blurred_wide_moments(split, tau_p, grid_->moments_read());
   return (1.0 - f) * (s_.filtered_lookups ? grid_->scattered_filtered(p, y_out, chi, cam.lateral_spread(t))
                                           : scattered(chi));
 }

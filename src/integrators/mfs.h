@@ -38,13 +38,14 @@
 // | `step_growth`             | number in [0, 100]            | 3         | steps of tau_step (1 + step_growth tau_red), tau_red the camera-side reduced depth; fixed steps of min(tau_step, 0.1) in the majorant cells where a medium may emit; on constant-density spheres and boxes each step is also at most two node spacings of the photon grids (docs/derivations.md D13) |
 // | `light_path`              | "forward" or "beer_lambert"   | "forward" | the light reaches the first wide scatter through peak scatters (reduced extinction), or unscattered only (the seed paper) |
 // | `propagator`              | "gsa" or "gaussian"           | "gsa"     | the peak's own moments in the small-angle propagator, or a Gaussian stand-in with the same theta2 |
-// | `peak_fraction`           | "auto" or [0, 0.99]           | "auto"    | f, the part of each phase function carried as a forward peak ("auto": g^2 per medium) |
+// | `peak_fraction`           | "auto" or [0, 0.99]           | "auto"    | f, the part of each phase function carried as a forward peak ("auto": min(chi_2, g) per medium, g^2 for HG) |
 // | `large_angle_scatters`    | "all" or integer in [0, 1024] | "all"     | K, at most K wide scatters per path (0: the peak only; 1: the seed's picture) |
 // | `photons`                 | "auto" or integer in [1, 2^26] | "auto"   | scatter grid photons per pass, shared among the lights (80 % by power, 20 % evenly) ("auto": 2^18 up to 128 x 128 pixels, then 2^18 sqrt(pixels / 128^2), half that where the camera looks into a directional or point light's forward peak, times clamp(sqrt(3.4 / C), 1/2, 4) for C real and null collisions per photon of a pilot (ScatterGridSettings::adaptive_photons), at most 2^26; the header of a rendered image holds the number chosen) |
 // | `photon_transport`        | "exact" or "similarity"       | "exact"   | scatter grid photons in the true medium, or in the delta-scaled one |
 // | `channel_passes`          | boolean                       | false     | chromatic media: one scatter grid photon pass per colour channel (each with its own coefficients) instead of one pass of hero-channel photons carrying all three (scatter_grid.h) |
 // | `scatter_grid_resolution` | "auto" or integer in [4, 96]  | "auto"    | scatter and beam grid nodes along the longest axis ("auto": ~1.6 optical depths per cell, 32 to 64, from 512 x 512 pixels on; 3/4 of that up to 128 x 128; the header of a rendered image holds the number chosen) |
 // | `scatter_grid_bands`      | "auto" or integer in [1, 6]   | "auto"    | spherical-harmonic bands the grid keeps and reads (l < bands; "auto": 1 where every medium scatters isotropically without a peak, else 3) |
+// | `grid_lobe_tail`          | boolean                       | true      | with 3 bands, the wide scatter of the grid's light also takes its l = 3..5 moments, extrapolated from a lobe about its l = 1 direction (ScatterGridSettings::lobe_tail) |
 // | `grid_denoise`            | boolean                       | true      | the scatter grid's nodes inside the media filtered where their difference from their neighbours is photon noise, by the photon batches' spread (grid_denoise.h) |
 // | `forward_side`            | "camera" or "light"           | "camera"  | peak scatters after the last wide scatter carried to the camera, or taken on the light's side with an exact camera leg |
 // | `beam_photons`            | "auto" or integer in [0, 2^24] | "auto"  | photons per light for the peak-only beam grid, shared among the channels' passes in chromatic media (0: straight beams; "auto": 2^13 sqrt(pixels / 128^2), at most 2^15, and 2^15 sqrt(pixels / 128^2), at most 8 x 2^15, for a light whose forward peak the camera looks into, and for every light in thin media (the scatter grid pilot's collisions per photon below 1.2), and none where no medium has a peak: auto_beam_photons in mfs_settings.cpp) |
@@ -123,6 +124,7 @@ struct MfsSettings {
   bool camera_shift = true;
   bool entry_loss = true;
   bool grid_denoise = true;
+  bool grid_lobe_tail = true;
   bool peak_toward_camera = false;
   bool wide_toward_camera = false;
   std::optional<bool> exact_light_transmittance;  // nullopt: "auto" (resolved by MfsIntegrator)

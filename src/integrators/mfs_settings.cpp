@@ -52,6 +52,7 @@ MfsSettings mfs_settings_from_json(const nlohmann::json& options, const std::str
   s.camera_shift = o.boolean("camera_shift", s.camera_shift);
   s.entry_loss = o.boolean("entry_loss", s.entry_loss);
   s.grid_denoise = o.boolean("grid_denoise", s.grid_denoise);
+  s.grid_lobe_tail = o.boolean("grid_lobe_tail", s.grid_lobe_tail);
   s.peak_toward_camera = o.boolean("peak_toward_camera", s.peak_toward_camera);
   s.wide_toward_camera = o.boolean("wide_toward_camera", s.wide_toward_camera);
   if (bool b = false; o.keyword_or_boolean("exact_light_transmittance", "auto", &b))
@@ -91,6 +92,7 @@ nlohmann::json to_json(const MfsSettings& s) {
                       {"camera_shift", s.camera_shift},
                       {"entry_loss", s.entry_loss},
                       {"grid_denoise", s.grid_denoise},
+                      {"grid_lobe_tail", s.grid_lobe_tail},
                       {"peak_toward_camera", s.peak_toward_camera},
                       {"wide_toward_camera", s.wide_toward_camera},
                       {"shadow_map_resolution", s.shadow_map_resolution}};
@@ -326,6 +328,7 @@ ScatterGridSettings scatter_grid_settings(const MfsSettings& s, bool adaptive, u
   grid.seed = seed;
   grid.majorants = tracking;
   grid.denoise = s.grid_denoise;
+  grid.lobe_tail = s.grid_lobe_tail;
   return grid;
 }
 

@@ -763,7 +763,10 @@ FloatArray sum_batches(const SceneContext& ctx, const ScatterGridSettings& s, co
 
 ScatterGrid::ScatterGrid(const SceneContext& ctx, const std::vector<const PhaseSplit*>& splits,
                          const std::vector<double>& peak_fraction, const ScatterGridSettings& s)
-    : bands_(std::clamp(s.bands, 1, kShMaxBands)), coeffs_(bands_ * bands_), photons_(s.photons) {
+    : bands_(std::clamp(s.bands, 1, kShMaxBands)),
+      coeffs_(bands_ * bands_),
+      lobe_tail_(s.lobe_tail && bands_ == 3),
+      photons_(s.photons) {
   const Bounds media_bounds = ctx.media.bounds();
   if (media_bounds.empty()) {
     values_.assign(grid_.size() * channels_ * coeffs_, 0.0f);  // the default grid: 2^3 nodes over [0, 1]^3
@@ -887,12 +890,17 @@ void ScatterGrid::accumulate(const TrilinearStencil& st, const float* v, double 
 Rgb ScatterGrid::evaluate(const double* L, const ShBasis& y_out,
                           const std::array<Rgb, kShMaxBands>& chi) const {
   const double* y = y_out.y;
+  double tail[kShMaxBands];
   Rgb r;
   for (int c = 0; c < 3; ++c) {
     const double* Lc = L + (channels_ == 1 ? 0 : coeffs_ * c);
     double v = 0.0;
     for (int l = 0; l < bands_; ++l)
       for (int h = l * l; h < (l + 1) * (l + 1); ++h) v += chi[l][c] * Lc[h] * y[h];
+    if (lobe_tail_) {
+      if (c == 0 || channels_ != 1) sh_lobe_tail(Lc, y, tail);  // one-channel grids: the same lobe
+      for (int l = bands_; l < kShMaxBands; ++l) v += chi[l][c] * tail[l];
+    }
     r[c] = std::max(0.0, tint_[c] * v);
   }
   return r;

@@ -100,6 +100,13 @@ struct ScatterGridSettings {
   // Filter the nodes inside the media where their difference from their neighbours is noise, by the
   // photon batches' spread (integrators/grid_denoise.h; `mfs`'s grid_denoise).
   bool denoise = false;
+  // With 3 bands: a lookup also takes the light's moments l = 3 .. kShMaxBands - 1, extrapolated from a lobe
+  // about its l = 1 direction d (the l-th Legendre moment along d proportional to (2l + 1) r^l, r from the
+  // l = 1 and l = 2 moments along d: exact for an isotropic part plus an HG lobe), each times the chi_l the
+  // lookup is given. Truncated at l = 2, the wide phase function read the light's forward lobe as if it were
+  // smooth: the front-lit r = 2 sphere's second wide scatter was +2.2 % of its image too bright
+  // (docs/derivations.md D12a).
+  bool lobe_tail = false;
 };
 
 class ScatterGrid {
@@ -126,6 +133,8 @@ class ScatterGrid {
   Rgb scattered_filtered(const Vec3& p, const ShBasis& y_out, const std::array<Rgb, kShMaxBands>& chi,
                          double spread) const;
   int bands() const { return bands_; }
+  // The moments chi_l a lookup reads, l < moments_read(): bands(), or kShMaxBands with the lobe tail.
+  int moments_read() const { return lobe_tail_ ? kShMaxBands : bands_; }
 
   // Similarity transport only: wide scatters whose direction the rejection sampler could not draw (the
   // photon flew on undeflected; see sample_by_rejection). 0 in every normal case.
@@ -144,6 +153,7 @@ class ScatterGrid {
  private:
   NodeGrid grid_;  // the media's bounds padded by one spacing (node_grid_padded)
   int bands_ = 3, coeffs_ = 9;
+  bool lobe_tail_ = false;  // ScatterGridSettings::lobe_tail, with 3 bands
   int photons_ = 0;
   std::optional<double> collisions_per_photon_;
   uint64_t rejection_failures_ = 0;

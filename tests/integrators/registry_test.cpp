@@ -106,9 +106,10 @@ TEST(Registry, DefaultsAreWrittenOut) {
   EXPECT_EQ(mfs["beam_photons"], "auto");
   EXPECT_EQ(mfs["beam_smoothing"], 2);
   EXPECT_EQ(mfs["grid_denoise"], true);
+  EXPECT_EQ(mfs["grid_lobe_tail"], true);
   EXPECT_EQ(mfs["camera_fluence"], false);
   EXPECT_EQ(mfs["wide_toward_camera"], false);
-  EXPECT_EQ(mfs.size(), 30u);  // every option of the table in mfs.h
+  EXPECT_EQ(mfs.size(), 31u);  // every option of the table in mfs.h
 }
 
 TEST(Registry, UnknownFieldsAndNamesAreErrors) {
