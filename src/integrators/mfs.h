@@ -171,10 +171,11 @@ class MfsIntegrator final : public Integrator {
   std::vector<double> drift_;                        // per medium 1 - chi_1 of its peak (eq. D19; empty: off)
   std::vector<TransmittanceGrid> full_maps_, reduced_maps_;  // per light
   std::unique_ptr<ScatterGrid> grid_;                        // wide scatters 2 .. K (null for K = 1)
-  std::unique_ptr<BeamGrid> beam_;                           // the peak-only beams' correction (or null)
-  std::vector<int> beam_counts_;                             // per light: the beam grid's photons
-  double max_step_ = 0.0;        // the longest march step over analytic pieces (the grids' node spacing)
-  bool shared_stencil_ = false;  // both photon grids, on one node layout: one stencil per march point
+  std::vector<int> grid_moments_;   // per medium: a grid lookup's chi_l, l < this (tail_moments in mfs.cpp)
+  std::unique_ptr<BeamGrid> beam_;  // the peak-only beams' correction (or null)
+  std::vector<int> beam_counts_;    // per light: the beam grid's photons
+  double max_step_ = 0.0;           // the longest march step over analytic pieces (the grids' node spacing)
+  bool shared_stencil_ = false;     // both photon grids, on one node layout: one stencil per march point
   // The beam grid is built: the forward light path and photons for some light.
   bool beam_on() const {
     return s_.forward_light_path() &&

@@ -255,7 +255,8 @@ std::array<Rgb, kShMaxBands> blurred_wide_moments(const PhaseSplit& split, const
   // eq. D12 with eq. D3's camera-side blur of the wide part.
   const std::vector<double>& chi_w = split.wide_moments();
   const std::vector<double>& chi_p = split.peak_moments();
-  std::array<Rgb, kShMaxBands> chi{};
+  std::array<Rgb, kShMaxBands> chi;
+  chi.fill(Rgb(0.0));  // (Rgb, an Imath vector, is not zeroed by {}): l >= bands read as 0
   for (int l = 0; l < bands; ++l) {
     const double one_minus_chi = 1.0 - moment(chi_p, l, 1.0);
     const Rgb e =
@@ -269,7 +270,8 @@ std::array<Rgb, kShMaxBands> whole_phase_moments(const PhaseSplit& split, double
   // eq. D12 with eq. D1's moments (chi_l of P itself).
   const std::vector<double>& chi_w = split.wide_moments();
   const std::vector<double>& chi_p = split.peak_moments();
-  std::array<Rgb, kShMaxBands> chi{};
+  std::array<Rgb, kShMaxBands> chi;
+  chi.fill(Rgb(0.0));  // (Rgb, an Imath vector, is not zeroed by {}): l >= bands read as 0
   for (int l = 0; l < bands; ++l)
     for (int c = 0; c < 3; ++c) chi[l][c] = f * moment(chi_p, l, 1.0) + (1.0 - f) * moment(chi_w, l, 0.0);
   return chi;

@@ -891,14 +891,18 @@ Rgb ScatterGrid::evaluate(const double* L, const ShBasis& y_out,
                           const std::array<Rgb, kShMaxBands>& chi) const {
   const double* y = y_out.y;
   double tail[kShMaxBands];
+  bool tail_found = false;
   Rgb r;
   for (int c = 0; c < 3; ++c) {
     const double* Lc = L + (channels_ == 1 ? 0 : coeffs_ * c);
     double v = 0.0;
     for (int l = 0; l < bands_; ++l)
       for (int h = l * l; h < (l + 1) * (l + 1); ++h) v += chi[l][c] * Lc[h] * y[h];
-    if (lobe_tail_) {
-      if (c == 0 || channels_ != 1) sh_lobe_tail(Lc, y, tail);  // one-channel grids: the same lobe
+    bool tail_read = false;  // chi_l beyond the bands given (mfs.cpp: tail_moments)
+    for (int l = bands_; l < kShMaxBands && lobe_tail_; ++l) tail_read = tail_read || chi[l][c] != 0.0;
+    if (tail_read) {
+      if (!tail_found || channels_ != 1) sh_lobe_tail(Lc, y, tail);  // one-channel grids: the same lobe
+      tail_found = true;
       for (int l = bands_; l < kShMaxBands; ++l) v += chi[l][c] * tail[l];
     }
     r[c] = std::max(0.0, tint_[c] * v);

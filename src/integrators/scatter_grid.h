@@ -117,7 +117,8 @@ class ScatterGrid {
 
   // sum_lm chi_l L_lm(p) Y_lm(w_out) per channel, l < bands (moments trilinear between nodes, zero
   // outside the grid), clamped at zero: the radiance a unit of scattering with Legendre moments chi_l
-  // (per channel; chi_0 = 1 for a normalised phase function) sends along w_out.
+  // (per channel; chi_0 = 1 for a normalised phase function) sends along w_out. With the lobe tail, plus
+  // chi_l times the tail's band l for bands <= l < kShMaxBands: chi must hold 0 there where none is wanted.
   Rgb scattered(const Vec3& p, const Vec3& w_out, const std::array<Rgb, kShMaxBands>& chi) const;
   // The same with Y_lm(w_out) evaluated once (ShBasis(w_out, bands())) for many points (bit for bit).
   Rgb scattered(const Vec3& p, const ShBasis& y_out, const std::array<Rgb, kShMaxBands>& chi) const;
