@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -21,6 +22,7 @@
 #include "nimbus/error.h"
 #include "nimbus/render.h"
 #include "nimbus/scene.h"
+#include "transport/phase_spec.h"
 
 namespace nimbus {
 
@@ -50,9 +52,26 @@ Phase parse_phase(JsonObject o) {
   } else if (type == "fournier_forand") {
     const double n = o.number_open_below("n", 1.0, 1.5), mu = o.number_open_below("mu", 3.0, 5.0);
     phase = make_ff_phase(n, mu);
+  } else if (type == "mie") {
+    // A table shipped in data/phase, by name (not a path: a scene's header must render the same anywhere).
+    const std::string table = o.string("table");
+    if (table.empty() || table[0] == '.' ||
+        table.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-.") !=
+            std::string::npos)
+      o.fail("table", fmt::format("'{}' is not a table name (letters, digits, '_', '-', '.'; e.g. "
+                                  "\"cloud_mie_550nm\", a table of {})",
+                                  table, phase_table_dir()));
+    const std::string path = phase_table_dir() + "/" + table + ".csv";
+    if (!std::filesystem::is_regular_file(path))
+      o.fail("table", fmt::format("no table '{}' ({} does not exist)", table, path));
+    try {
+      phase = load_phase_table(table, path);
+    } catch (const Error& e) {
+      o.fail("table", e.what());
+    }
   } else {
     o.fail("type", fmt::format("unknown phase function '{}' (known: isotropic, hg, double_hg, gauss, "
-                               "fournier_forand)",
+                               "fournier_forand, mie)",
                                type));
   }
   o.finish();

@@ -7,8 +7,10 @@
 #include <fstream>
 
 #include "core/math.h"
+#include "media/phase.h"
 #include "nimbus/error.h"
 #include "support/scenes.h"
+#include "transport/phase_spec.h"
 
 namespace nimbus {
 namespace {
@@ -80,7 +82,7 @@ TEST(Scene, BadInputCatalogue) {
       {"/media/0/phase/g", -1.5, false, "scene.json: /media/0/phase/g: must satisfy |g| < 1"},
       {"/media/0/phase/type", "rayleigh", false,
        "scene.json: /media/0/phase/type: unknown phase function 'rayleigh' (known: isotropic, hg, double_hg, "
-       "gauss, fournier_forand)"},
+       "gauss, fournier_forand, mie)"},
       {"/media/0/shape/radius", 0.0, false, "scene.json: /media/0/shape/radius: must be > 0"},
       {"/media/0/shape/type", "torus", false,
        "scene.json: /media/0/shape/type: unknown shape 'torus' (known: sphere, box, vdb, cloud)"},
@@ -121,6 +123,29 @@ TEST(Scene, BadInputCatalogue) {
   for (const Case& c : cases) {
     EXPECT_EQ(message_for(c.pointer, c.value, c.remove), c.expected) << c.pointer;
   }
+}
+
+// A Mie table of data/phase by name: the same phase function as the CLI's mie:NAME; a path, an unknown name or
+// no name is an error that names the field.
+TEST(Scene, MiePhaseByTableName) {
+  nlohmann::json doc = nlohmann::json::parse(kGood);
+  doc["media"][0]["phase"] = {{"type", "mie"}, {"table", "cloud_mie_550nm"}};
+  const Scene s = parse_scene(doc, "scene.json", ".");
+  const auto& t = std::get<TabulatedPhase>(s.media[0].phase);
+  const Phase cli = parse_phase_spec("mie:cloud_mie_550nm");
+  EXPECT_EQ(t.value, std::get<TabulatedPhase>(cli).value);
+  EXPECT_NEAR(phase_mean_cosine(s.media[0].phase), 0.864, 1e-3);  // the table's header: g = 0.86395
+  for (const auto& [table, says] :
+       std::vector<std::pair<std::string, std::string>>{{"../phase/cloud_mie_550nm", "is not a table name"},
+                                                        {"/tmp/cloud.csv", "is not a table name"},
+                                                        {"", "is not a table name"},
+                                                        {"no_such_table", "no table 'no_such_table'"}}) {
+    const std::string got = message_for("/media/0/phase", {{"type", "mie"}, {"table", table}});
+    EXPECT_EQ(got.rfind("scene.json: /media/0/phase/table: ", 0), 0u) << got;
+    EXPECT_NE(got.find(says), std::string::npos) << got;
+  }
+  EXPECT_EQ(message_for("/media/0/phase", {{"type", "mie"}}),
+            "scene.json: /media/0/phase/table: required field is missing");
 }
 
 TEST(Scene, NonFiniteNumbersAreRejected) {
