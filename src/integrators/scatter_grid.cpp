@@ -353,6 +353,11 @@ struct ScatterPhotons {
   Rgb extinction(const MediumPoint& mp) const {
     return s.exact_transport ? mp.sigma_t() : reduced_sigma_t(mp, peak_fraction);
   }
+  // Whether a walk's tentative collisions take their extinction from the media's values (eval), which the
+  // real collision then reads: not in emitting media, where eval also finds the emission.
+  bool values_at_collisions() const {
+    return (s.exact_transport || !peak_fraction.empty()) && !ctx.media.emits();
+  }
   void trace_hero(const Photon& ph, int hero, const Rgb& share, const TallyBlock& block, int first_order,
                   CornerUniforms* corners, Rng& rng, PhotonBatch& batch) const;
   // A photon of grey media (RGB power) or of channel c's pass (that channel's power only).
@@ -415,7 +420,7 @@ void ScatterPhotons::trace_channel(const Photon& ph, int c, const TallyBlock& bl
   // where eval also finds the emission.)
   MediumPoint at_collision;
   bool known = false;
-  const bool from_point = (s.exact_transport || !peak_fraction.empty()) && !ctx.media.emits();
+  const bool from_point = values_at_collisions();
   walk_photon(
       ctx, s.majorants ? *s.majorants : ctx.majorants, ph.x, ph.w, majorant_scale, rng, &batch.collisions,
       [&](const Vec3& p, double maj) {
@@ -541,7 +546,7 @@ void ScatterPhotons::trace_hero(const Photon& ph, int hero, const Rgb& share, co
   Vec3 dir = ph.w;  // the current flight's direction
   // The media's values at the last tentative collision (as trace_channel; not in emitting media).
   MediumPoint at_collision;
-  const bool from_point = (s.exact_transport || !peak_fraction.empty()) && !ctx.media.emits();
+  const bool from_point = values_at_collisions();
   walk_photon(
       ctx, s.majorants ? *s.majorants : ctx.majorants, ph.x, ph.w, majorant_scale, rng, &batch.collisions,
       [&](const Vec3& p, double maj) {

@@ -55,9 +55,7 @@ Phase parse_phase(JsonObject o) {
   } else if (type == "mie") {
     // A table shipped in data/phase, by name (not a path: a scene's header must render the same anywhere).
     const std::string table = o.string("table");
-    if (table.empty() || table[0] == '.' ||
-        table.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-.") !=
-            std::string::npos)
+    if (!is_phase_table_name(table))
       o.fail("table", fmt::format("'{}' is not a table name (letters, digits, '_', '-', '.'; e.g. "
                                   "\"cloud_mie_550nm\", a table of {})",
                                   table, phase_table_dir()));

@@ -67,6 +67,12 @@ std::string phase_table_dir() {
   return std::string(NIMBUS_SOURCE_DIR) + "/data/phase";
 }
 
+bool is_phase_table_name(const std::string& name) {
+  return !name.empty() && name[0] != '.' &&
+         name.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-.") ==
+             std::string::npos;
+}
+
 TabulatedPhase load_phase_table(const std::string& name, const std::string& path) {
   std::ifstream in(path);
   if (!in) throw Error(fmt::format("phase table '{}': cannot open {}", name, path));
@@ -120,10 +126,7 @@ Phase parse_phase_spec(const std::string& spec) {
     if (args.find('/') != std::string::npos ||
         (args.size() > 4 && args.compare(args.size() - 4, 4, ".csv") == 0))
       return load_phase_table(std::filesystem::path(args).stem().string(), args);
-    if (args.empty() ||
-        args.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-.") !=
-            std::string::npos ||
-        args[0] == '.')
+    if (!is_phase_table_name(args))
       throw Error(fmt::format("phase '{}': mie needs a table name of letters, digits, '_', '-', '.'", spec));
     return load_phase_table(args, phase_table_dir() + "/" + args + ".csv");
   }

@@ -27,4 +27,8 @@ TabulatedPhase load_phase_table(const std::string& name, const std::string& path
 // prefix), else NIMBUS_SOURCE_DIR/data/phase.
 std::string phase_table_dir();
 
+// Whether `name` names a table of phase_table_dir() (letters, digits, '_', '-', '.', not starting with '.'):
+// never a path, so it cannot leave that directory.
+bool is_phase_table_name(const std::string& name);
+
 }  // namespace nimbus
