@@ -89,6 +89,56 @@ Photon emit(const SceneContext& ctx, size_t source, const Vec3& c, double r, dou
   return p;
 }
 
+std::optional<LightFootprint> light_footprint(const MajorantGrid& majorants, const Vec3& w, const Vec3& c,
+                                              double r) {
+  const Bounds b = majorants.bounds();
+  const auto m = majorants.resolution();
+  if (b.empty() || !(r > 0.0)) return std::nullopt;
+  const Vec3 size = (b.hi - b.lo) / Vec3(m[0], m[1], m[2]);
+  LightFootprint fp;
+  fp.frame = Frame(normalize(w));
+  fp.origin = c - fp.frame.n * (2.0 * r);
+  fp.r = r;
+  fp.res = std::clamp(int(std::ceil(4.0 * r / std::min({size.x, size.y, size.z}))), 8, 512);
+  fp.cell = 2.0 * r / fp.res;
+  // A cell's box projects inside the rectangle of half sides sum_a |e_a| size_a / 2 about its centre's
+  // projection, e the frame's axis s or t.
+  const Vec3 hs = size * 0.5;
+  const double half_u =
+      std::abs(fp.frame.s.x) * hs.x + std::abs(fp.frame.s.y) * hs.y + std::abs(fp.frame.s.z) * hs.z;
+  const double half_v =
+      std::abs(fp.frame.t.x) * hs.x + std::abs(fp.frame.t.y) * hs.y + std::abs(fp.frame.t.z) * hs.z;
+  std::vector<uint8_t> marked(size_t(fp.res) * fp.res, 0);
+  const auto index = [&](double x) { return std::clamp(int(std::floor((x + r) / fp.cell)), 0, fp.res - 1); };
+  for (int z = 0; z < m[2]; ++z)
+    for (int y = 0; y < m[1]; ++y)
+      for (int x = 0; x < m[0]; ++x) {
+        if (!(majorants.cell_majorant(x, y, z) > 0.0)) continue;
+        const Vec3 q = fp.frame.to_local(b.lo + (Vec3(x, y, z) + Vec3(0.5)) * size - c);
+        // Widened by 1e-6 of a raster cell against rounding; the box lies in the sphere, so in the square.
+        const double eps = 1e-6 * fp.cell;
+        for (int v = index(q.y - half_v - eps); v <= index(q.y + half_v + eps); ++v)
+          for (int u = index(q.x - half_u - eps); u <= index(q.x + half_u + eps); ++u)
+            marked[size_t(v) * fp.res + u] = 1;
+      }
+  for (size_t i = 0; i < marked.size(); ++i)
+    if (marked[i]) fp.cells.push_back(uint32_t(i));
+  if (fp.cells.empty() || fp.area() >= 0.9 * kPi * r * r) return std::nullopt;
+  return fp;
+}
+
+Photon emit_over(const LightFootprint& fp, const Rgb& irradiance, double n, Rng& rng) {
+  const double u1 = rng.uniform(), u2 = rng.uniform(), u3 = rng.uniform();
+  rng.uniform();  // emit's fourth number, not needed here
+  const size_t k = std::min(size_t(u3 * double(fp.cells.size())), fp.cells.size() - 1);
+  const int u = int(fp.cells[k] % uint32_t(fp.res)), v = int(fp.cells[k] / uint32_t(fp.res));
+  Photon p;
+  p.w = fp.frame.n;
+  p.x = fp.origin + fp.frame.to_world({-fp.r + (u + u1) * fp.cell, -fp.r + (v + u2) * fp.cell, 0.0});
+  p.power = irradiance * (fp.area() / n);
+  return p;
+}
+
 namespace {
 
 // A point of the plane through c normal to w, from emit_with_surfaces' mixture (u0 < kAimedShare: uniform

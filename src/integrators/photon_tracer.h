@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <functional>
 #include <limits>
+#include <optional>
 #include <type_traits>
 #include <vector>
 
@@ -48,6 +49,29 @@ struct Photon {
 // Always consumes 4 uniform numbers.
 Photon emit(const SceneContext& ctx, size_t source, const Vec3& c, double r, double n, Rng& rng,
             const double* strat = nullptr);
+
+// The lines of a directional light's beam that can meet the media: the cells of a raster over the square
+// about emit's disc (normal to the light's direction w, centre c, radius r) onto which some cell of
+// non-zero majorant projects along w (the projection of its box, widened to a rectangle of the raster's
+// axes). A photon of emit's disc on any other line flies past every medium; for a sphere the disc (of
+// the sphere about its bounding box) is three times its cross-section, and on the suite's spheres and
+// the Disney cloud 2/3 to 3/4 of emit's photons met nothing. emit_over draws over the footprint only.
+struct LightFootprint {
+  Frame frame{Vec3(0, 0, 1)};  // about w, as emit's disc
+  Vec3 origin;                 // the disc's centre: c - 2 r w, where emit's photons start
+  double r = 0.0;
+  double cell = 0.0;            // the raster's cell side
+  int res = 0;                  // cells per side (the square [-r, r]^2 of the frame's s, t)
+  std::vector<uint32_t> cells;  // the footprint's cells, v res + u
+  double area() const { return double(cells.size()) * cell * cell; }
+};
+// The footprint of w's beam on the majorant grid's non-empty cells (raster cells of half the grid's
+// smallest cell side, 8 to 512 per side), or none where it covers 90 % of the disc or more.
+std::optional<LightFootprint> light_footprint(const MajorantGrid& majorants, const Vec3& w, const Vec3& c,
+                                              double r);
+// A directional light's photon (irradiance E along the footprint's w), uniform over its cells: power
+// E area / n for n photons. Consumes 4 uniform numbers, as emit.
+Photon emit_over(const LightFootprint& fp, const Rgb& irradiance, double n, Rng& rng);
 
 // emit for a scene with surfaces: the light's photons also reach the media by way of the surfaces (the
 // sunlit ground under a cloud lights its base; emit's photons, all aimed at the media's sphere, land only

@@ -315,11 +315,18 @@ struct ScatterPhotons {
   // `pieces`, the full extinction): its majorant is the extinction wherever a tentative collision falls.
   bool exact_pieces;
   std::vector<SourceBlock> blocks;  // per source, as trace numbers them
+  // Per light: a directional light's footprint on the media (light_footprint; none for other lights, with
+  // surfaces, or where it would save little). Its photons are drawn over it, and the light takes the share
+  // area / (pi radius^2) of the photons photon_split gives it: the same photons meet the media, in
+  // expectation, as from emit's whole disc, without those that would fly past them.
+  std::vector<std::optional<LightFootprint>> footprints{};
+  size_t planned = 0;  // photon_split's photons per pass, before the footprints' shares
   // Whether flights are deposited: the pilot (pilot_collisions) only counts collisions, so its tally's
   // pages are never touched. The walks draw the same numbers either way.
   bool deposits = true;
 
-  void split(int photons);  // first = photon_split(..., photons, ...), and surface
+  // first = photon_split(..., photons, ...), each footprint's light's count times its share, and surface.
+  void split(int photons);
   void trace(size_t j, Rng& rng, PhotonBatch& batch) const;
   // A flight's deposit offset (deposit_flight): a uniform, one per flight, drawn also with
   // deposit_midpoints (which takes 1/2) so that the walks are the same either way.
@@ -384,7 +391,9 @@ void ScatterPhotons::trace(size_t j, Rng& rng, PhotonBatch& batch) const {
   const bool light_like = source < ctx.lights.size() || (source == ctx.lights.size() && ctx.env_map);
   const int first_order = light_like && !from_media ? 1 : 0;
   const int c = pass;  // the channel whose coefficients drive this photon
-  const Photon ph = from_media             ? emit_from_media(*emission, ctx.media, n, rng)
+  const LightFootprint* fp = src < footprints.size() && footprints[src] ? &*footprints[src] : nullptr;
+  const Photon ph = from_media ? emit_from_media(*emission, ctx.media, n, rng)
+                    : fp ? emit_over(*fp, std::get<DirectionalLight>(ctx.lights[src]).irradiance, n, rng)
                     : ctx.surfaces.empty() ? emit(ctx, source, centre, radius, n, rng)
                                            : emit_with_surfaces(ctx, source, centre, radius, surface, n, rng);
   const SourceBlock& sb = blocks[src];
@@ -695,11 +704,36 @@ constexpr double kDenseCollisions = 3.4;
 constexpr double kMinPhotonFactor = 0.5;
 constexpr double kMaxPhotonFactor = 4.0;
 
+// Per light: light_footprint for a directional light of a scene without surfaces (whose light also reaches
+// the media by way of the surfaces, emit_with_surfaces), else none.
+std::vector<std::optional<LightFootprint>> light_footprints(const SceneContext& ctx,
+                                                            const MajorantGrid& majorants, const Vec3& centre,
+                                                            double radius) {
+  std::vector<std::optional<LightFootprint>> fp(ctx.lights.size());
+  if (!ctx.surfaces.empty()) return fp;
+  for (size_t i = 0; i < ctx.lights.size(); ++i)
+    if (const auto* d = std::get_if<DirectionalLight>(&ctx.lights[i]))
+      fp[i] = light_footprint(majorants, d->direction, centre, radius);
+  return fp;
+}
+
 // Whether a pilot sets the count.
 bool wants_pilot(const ScatterGridSettings& s) { return s.adaptive_photons > 0; }
 
 void ScatterPhotons::split(int photons) {
+  if (footprints.empty())
+    footprints = light_footprints(ctx, s.majorants ? *s.majorants : ctx.majorants, centre, radius);
   first = photon_split(ctx, emission, s, photons, lights, sources, centre, radius);
+  planned = first.back();
+  std::vector<size_t> count(sources);
+  for (size_t i = 0; i < sources; ++i) {
+    count[i] = first[i + 1] - first[i];
+    if (i < footprints.size() && footprints[i]) {
+      const double share = footprints[i]->area() / (kPi * radius * radius);
+      count[i] = std::max<size_t>(1, size_t(std::llround(share * double(count[i]))));
+    }
+  }
+  for (size_t i = 0; i < sources; ++i) first[i + 1] = first[i] + count[i];
   if (!ctx.surfaces.empty()) surface = surface_emission(ctx, centre, radius);
 }
 
@@ -717,7 +751,8 @@ double pilot_collisions(ScatterPhotons& photons, size_t tally_size) {
     photons.trace(j, rng, batch);
   }
   photons.deposits = true;
-  return (batch.collisions + batch.null_collisions) / double(n);
+  // Per photon of emit's disc (the footprints' photons stand for planned / n as many).
+  return (batch.collisions + batch.null_collisions) / double(photons.planned);
 }
 
 // s.adaptive_photons x clamp(sqrt(kDenseCollisions / collisions), kMinPhotonFactor, kMaxPhotonFactor), at most

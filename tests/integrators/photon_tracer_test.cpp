@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <cmath>
@@ -122,6 +123,60 @@ TEST(PhotonTracer, GridsOfAUsualSceneHaveNoRejectionFailures) {
   ASSERT_NE(mfs.beam_grid(), nullptr);
   EXPECT_EQ(mfs.scatter_grid()->rejection_failures(), 0u);
   EXPECT_EQ(mfs.beam_grid()->rejection_failures(), 0u);
+}
+
+// A directional light's footprint (light_footprint) holds every line of emit's disc that meets a medium:
+// lines through 200 000 uniform points of the disc, tested against the shape itself, for a sphere and for
+// a box, lit obliquely. It is smaller than the disc (a sphere's: at most 0.9 of it, at least its own
+// cross-section), and emit_over's photons start in it and carry E x area in all.
+TEST(PhotonTracer, LightFootprintHoldsEveryLineThatMeetsTheMedia) {
+  const Vec3 w = normalize(Vec3(1.0, 0.3, -0.2));
+  for (const bool sphere : {true, false}) {
+    const std::string shape = sphere ? R"({"type": "sphere", "center": [0.5, 0, 0], "radius": 1})"
+                                     : R"({"type": "box", "min": [-1, -0.5, -0.25], "max": [1, 0.5, 0.25]})";
+    const Scene scene = test::scene_from_json("{" + test::camera_json(8, 8) + R"(, "media": [{"shape": )" +
+                                              shape + R"(, "sigma_s": 0.9, "sigma_a": 0.1}],
+      "lights": [{"type": "directional", "direction": [1, 0, 0], "irradiance": 1.0}]})");
+    const SceneContext ctx(scene);
+    const Bounds b = ctx.media.bounds();
+    const Vec3 c = (b.lo + b.hi) * 0.5;
+    const double r = 0.5 * (b.hi - b.lo).length() * (1.0 + 1e-9);
+    const std::optional<LightFootprint> fp = light_footprint(ctx.majorants, w, c, r);
+    ASSERT_TRUE(fp.has_value()) << (sphere ? "sphere" : "box");
+    const double disc = kPi * r * r;
+    EXPECT_LT(fp->area(), 0.9 * disc);
+    if (sphere) EXPECT_GT(fp->area(), kPi);
+    const auto in_footprint = [&](double x, double y) {
+      const int u = int(std::floor((x + r) / fp->cell)), v = int(std::floor((y + r) / fp->cell));
+      return std::binary_search(fp->cells.begin(), fp->cells.end(), uint32_t(v * fp->res + u));
+    };
+    int meeting = 0, missed = 0;
+    Rng rng(5, 0);
+    for (int j = 0; j < 200000; ++j) {
+      const double rho = r * std::sqrt(rng.uniform()), phi = 2.0 * kPi * rng.uniform();
+      const double x = rho * std::cos(phi), y = rho * std::sin(phi);
+      const Vec3 o = fp->origin + fp->frame.to_world({x, y, 0.0});
+      double t0 = 0.0, t1 = 0.0;
+      const Vec3 oc = o - Vec3(0.5, 0, 0);
+      const double along = -dot(oc, w);
+      const bool meets = sphere ? (oc + w * along).length() < 1.0 : b.intersect(o, w, 0.0, 1e9, &t0, &t1);
+      meeting += meets;
+      missed += meets && !in_footprint(x, y);
+    }
+    EXPECT_GT(meeting, 10000);
+    EXPECT_EQ(missed, 0) << (sphere ? "sphere" : "box");
+    // emit_over: every photon starts on a footprint cell's line, along w, with power E area / n.
+    const Rgb irradiance(2.0, 1.0, 0.5);
+    for (int j = 0; j < 1000; ++j) {
+      Rng prng(9, uint64_t(j));
+      const Photon p = emit_over(*fp, irradiance, 1000.0, prng);
+      const Vec3 q = fp->frame.to_local(p.x - fp->origin);
+      EXPECT_NEAR(q.z, 0.0, 1e-9);
+      EXPECT_TRUE(in_footprint(q.x, q.y));
+      EXPECT_NEAR((p.w - w).length(), 0.0, 1e-12);
+      EXPECT_NEAR(p.power.x * 1000.0, 2.0 * fp->area(), 1e-9 * fp->area());
+    }
+  }
 }
 
 }  // namespace
