@@ -216,12 +216,29 @@ def measure(tag, scene, base, ref, label, block, spp, extra=(), seed=1):
     return row, out
 
 
+def measure_seeds(tag, scene, base, ref, label, block, spp, seeds):
+    """measure() over seeds 1 .. seeds: the rel RMSE is the root mean square of the seeds' (the error a render
+    has on average: one seed's moves with its photon grids' noise, by 20 % on the Disney cloud), the mean error,
+    CPU and wall time their means. Returns the row and seed 1's image."""
+    rows, first = [], None
+    for seed in range(1, seeds + 1):
+        row, out = measure(tag, scene, base, ref, label if seeds == 1 else f"{label}s{seed}", block, spp, seed=seed)
+        rows.append(row)
+        first = first or out
+    if seeds == 1:
+        return rows[0], first
+    mean = lambda key: sum(x[key] for x in rows) / seeds
+    return ({"spp": spp, "seeds": seeds, "mean_error": mean("mean_error"),
+             "rel_rmse": math.sqrt(sum(x["rel_rmse"] ** 2 for x in rows) / seeds), "time_s": mean("time_s"),
+             "cpu_s": mean("cpu_s")}, first)
+
+
 def frontier(tag, scene, base, ref_spp, mfs_spp=MFS_SPP, octave_spp=OCTAVE_SPP, pt_spp=PT_SPP, pt_noise=PT_NOISE,
-             images=None, judge=None):
+             images=None, judge=None, mfs_seeds=1):
     """One scene's error-vs-time frontier: mfs and octave at a few spp, pathtrace uniform and adaptive, all
     against one converged reference, back to back; equal-error times and speed-ups from the fitted curves.
     judge: an earlier result of this scene whose pathtrace, adaptive and octave points are kept (only mfs
-    is rendered again)."""
+    is rendered again). mfs_seeds: each mfs point is the mean of that many seeds' renders (measure_seeds)."""
     ref, noise = reference(tag, scene, base, ref_spp)
     exposure = math.log2(0.3 / max(compare(ref, ref)[2], 1e-12))
     if images:
@@ -229,7 +246,7 @@ def frontier(tag, scene, base, ref_spp, mfs_spp=MFS_SPP, octave_spp=OCTAVE_SPP, 
     r = {"reference_spp": ref_spp, "reference_noise_rel_rmse": noise, "width": scene["camera"]["width"],
          "height": scene["camera"]["height"], "mfs": [], "octave": [], "pathtrace": [], "adaptive": []}
     for spp in mfs_spp:
-        row, out = measure(tag, scene, base, ref, f"mfs{spp}", {"type": "mfs"}, spp)
+        row, out = measure_seeds(tag, scene, base, ref, f"mfs{spp}", {"type": "mfs"}, spp, mfs_seeds)
         r["mfs"].append(row)
         if images and spp == 4:
             png(out, os.path.join(IMG, f"{images}_mfs.png"), exposure)
@@ -299,6 +316,8 @@ def main():
     ap.add_argument("--res", type=int, default=128, help="image size of the suite (res x res)")
     ap.add_argument("--results", help="results file (default docs/validation/render_results.json)")
     ap.add_argument("--mfs-spp", default=",".join(map(str, MFS_SPP)), help="the mfs frontier's spp, e.g. 1,4,16")
+    ap.add_argument("--mfs-seeds", type=int, default=4,
+                    help="seeds per mfs point: its error the root mean square of theirs, its times their mean")
     ap.add_argument("--mfs-only", action="store_true",
                     help="render only mfs again; keep the judge's and octave's points (and reference) of the results")
     ap.add_argument("--ref-spp", type=json.loads, help='reference spp per scene, JSON: {"disney_cloud": 256}')
@@ -334,7 +353,7 @@ def main():
         if judge:
             ref_spp = judge["reference_spp"]  # the judge's points were measured against this reference
         r = frontier(tag, sc, base, ref_spp, mfs_spp=[int(x) for x in args.mfs_spp.split(",")], images=name,
-                     judge=judge)
+                     judge=judge, mfs_seeds=args.mfs_seeds)
         r["mfs_commit"], r["mfs_machine"] = commit_id(), machine_state()
         r["commit"], r["machine"] = (judge["commit"], judge["machine"]) if judge else (r["mfs_commit"],
                                                                                        r["mfs_machine"])
