@@ -164,7 +164,7 @@ OCTAVE_SPP = [1, 4]
 PT_SPP = [4, 16, 64, 256]  # uniform path tracing
 PT_NOISE = [0.2, 0.1, 0.05]  # adaptive path tracing, render --noise E
 REF_SPP_128 = {"sphere_r10_a0.99_hg0.85_back": 4096, "sphere_r20_a0.9999_hg0.95_back": 2048,
-               "sphere_r50_a0.9999_hg0.85_side": 1024, "disney_cloud": 512, "disney_cloud_thin": 1024,
+               "sphere_r50_a0.9999_hg0.85_side": 1024, "disney_cloud": 4096, "disney_cloud_thin": 4096,
                "disney_cloud_back": 1024, "disney_cloud_dense": 1024}
 
 
@@ -219,10 +219,11 @@ def measure(tag, scene, base, ref, label, block, spp, extra=(), seed=1):
 def measure_seeds(tag, scene, base, ref, label, block, spp, seeds):
     """measure() over seeds 1 .. seeds: the rel RMSE is the root mean square of the seeds' (the error a render
     has on average: one seed's moves with its photon grids' noise, by 20 % on the Disney cloud), the mean error,
-    CPU and wall time their means. Returns the row and seed 1's image."""
+    CPU and wall time their means. Returns the row and seed 1's image (the file of the plain label)."""
     rows, first = [], None
     for seed in range(1, seeds + 1):
-        row, out = measure(tag, scene, base, ref, label if seeds == 1 else f"{label}s{seed}", block, spp, seed=seed)
+        # Seed 1's image keeps the plain label's file (bin_sizes reads it).
+        row, out = measure(tag, scene, base, ref, label if seed == 1 else f"{label}s{seed}", block, spp, seed=seed)
         rows.append(row)
         first = first or out
     if seeds == 1:
@@ -327,7 +328,7 @@ def main():
     if args.size_study:
         return size_study()
     if args.size_frontier:
-        return size_frontier(args.size_frontier.split(","), args.ref_spp or {})
+        return size_frontier(args.size_frontier.split(","), args.ref_spp or {}, args.mfs_seeds)
     if args.orders:
         return orders()
     if args.options:
@@ -462,7 +463,7 @@ SIZE_RESULTS = os.path.join(DOCS, "render_512_results.json")
 REF_SPP_512 = {"disney_cloud": 512, "sphere_r10_a0.99_hg0.85_front": 2048, "sphere_r2_a0.99_hg0.85_side": 8192}
 
 
-def size_frontier(names, ref_spp):
+def size_frontier(names, ref_spp, mfs_seeds=1):
     """The frontier at 512 x 512 of the scenes `names`: a converged reference (REF_SPP_512 or --ref-spp), `mfs` at
     1 and 4 spp and `pathtrace` at 4, 16 and 64 spp (uniform; adaptive and octave are not run at this size), all
     back to back; the same fits as at 128 x 128. Writes render_512_results.json and the size512 section."""
@@ -473,7 +474,7 @@ def size_frontier(names, ref_spp):
         sc = sized(scene, 512, 512)
         spp = int(ref_spp.get(name, REF_SPP_512.get(name, 2048)))
         r = frontier(f"{name}_512x512", sc, base, spp, mfs_spp=[1, 4], octave_spp=[], pt_spp=[4, 16, 64],
-                     pt_noise=[])
+                     pt_noise=[], mfs_seeds=mfs_seeds)
         r["bins"] = bin_sizes(f"{name}_512x512", spp, r)
         r["commit"], r["machine"] = commit_id(), machine_state()
         results[name] = r
@@ -530,9 +531,9 @@ def size_frontier_text():
     write_frontier_section("size512", head, res)
     bins = bin_rows(res)
     if bins:
-        text = "\n".join(["`mfs` at 1 spp by bin size (`nimbus compare --bin B --min-ref 0.05`; path tracing's c "
-                          "from the references' two halves; the reference's noise removed from `mfs`'s error; CPU "
-                          "times of the table above):", ""] + bins)
+        text = "\n".join(["`mfs` at 1 spp (seed 1) by bin size (`nimbus compare --bin B --min-ref 0.05`; path "
+                          "tracing's c from the references' two halves; the reference's noise removed from `mfs`'s "
+                          "error; CPU times of the table above):", ""] + bins)
         print(text)
         write_between_markers("size512bins", text)
     return True
