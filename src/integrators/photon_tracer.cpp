@@ -89,53 +89,124 @@ Photon emit(const SceneContext& ctx, size_t source, const Vec3& c, double r, dou
   return p;
 }
 
-std::optional<LightFootprint> light_footprint(const MajorantGrid& majorants, const Vec3& w, const Vec3& c,
-                                              double r) {
+namespace {
+
+// The raster cell index of a plane coordinate x in [-half, half] (clamped).
+int raster_index(const LightFootprint& fp, double x) {
+  return std::clamp(int(std::floor((x + fp.half) / fp.cell)), 0, fp.res - 1);
+}
+
+// Marks the raster cells of the rectangle [u0, u1] x [v0, v1] (widened by 1e-6 of a cell against rounding).
+void mark(const LightFootprint& fp, double u0, double u1, double v0, double v1,
+          std::vector<uint8_t>* marked) {
+  const double eps = 1e-6 * fp.cell;
+  for (int v = raster_index(fp, v0 - eps); v <= raster_index(fp, v1 + eps); ++v)
+    for (int u = raster_index(fp, u0 - eps); u <= raster_index(fp, u1 + eps); ++u)
+      (*marked)[size_t(v) * fp.res + u] = 1;
+}
+
+// The footprint's raster over [-half, half]^2 (cells of half the majorant grid's smallest cell side), the cells
+// that rect(lo, size) marks for each non-empty majorant cell (corner lo, sides size), and the cells kept.
+template <typename Rect>
+void rasterise(const MajorantGrid& majorants, LightFootprint* fp, Rect&& rect) {
   const Bounds b = majorants.bounds();
   const auto m = majorants.resolution();
-  if (b.empty() || !(r > 0.0)) return std::nullopt;
   const Vec3 size = (b.hi - b.lo) / Vec3(m[0], m[1], m[2]);
+  fp->res = std::clamp(int(std::ceil(4.0 * fp->half / std::min({size.x, size.y, size.z}))), 8, 512);
+  fp->cell = 2.0 * fp->half / fp->res;
+  std::vector<uint8_t> marked(size_t(fp->res) * fp->res, 0);
+  for (int z = 0; z < m[2]; ++z)
+    for (int y = 0; y < m[1]; ++y)
+      for (int x = 0; x < m[0]; ++x)
+        if (majorants.cell_majorant(x, y, z) > 0.0) rect(b.lo + Vec3(x, y, z) * size, size, &marked);
+  for (size_t i = 0; i < marked.size(); ++i)
+    if (marked[i]) fp->cells.push_back(uint32_t(i));
+}
+
+// Cell i's centre in the plane's coordinates.
+std::pair<double, double> cell_centre(const LightFootprint& fp, uint32_t i) {
+  const int u = int(i % uint32_t(fp.res)), v = int(i / uint32_t(fp.res));
+  return {-fp.half + (u + 0.5) * fp.cell, -fp.half + (v + 0.5) * fp.cell};
+}
+
+}  // namespace
+
+std::optional<LightFootprint> light_footprint(const MajorantGrid& majorants, const Vec3& w, const Vec3& c,
+                                              double r) {
+  if (majorants.bounds().empty() || !(r > 0.0)) return std::nullopt;
   LightFootprint fp;
   fp.frame = Frame(normalize(w));
   fp.origin = c - fp.frame.n * (2.0 * r);
-  fp.r = r;
-  fp.res = std::clamp(int(std::ceil(4.0 * r / std::min({size.x, size.y, size.z}))), 8, 512);
-  fp.cell = 2.0 * r / fp.res;
+  fp.half = r;
   // A cell's box projects inside the rectangle of half sides sum_a |e_a| size_a / 2 about its centre's
-  // projection, e the frame's axis s or t.
-  const Vec3 hs = size * 0.5;
-  const double half_u =
-      std::abs(fp.frame.s.x) * hs.x + std::abs(fp.frame.s.y) * hs.y + std::abs(fp.frame.s.z) * hs.z;
-  const double half_v =
-      std::abs(fp.frame.t.x) * hs.x + std::abs(fp.frame.t.y) * hs.y + std::abs(fp.frame.t.z) * hs.z;
-  std::vector<uint8_t> marked(size_t(fp.res) * fp.res, 0);
-  const auto index = [&](double x) { return std::clamp(int(std::floor((x + r) / fp.cell)), 0, fp.res - 1); };
-  for (int z = 0; z < m[2]; ++z)
-    for (int y = 0; y < m[1]; ++y)
-      for (int x = 0; x < m[0]; ++x) {
-        if (!(majorants.cell_majorant(x, y, z) > 0.0)) continue;
-        const Vec3 q = fp.frame.to_local(b.lo + (Vec3(x, y, z) + Vec3(0.5)) * size - c);
-        // Widened by 1e-6 of a raster cell against rounding; the box lies in the sphere, so in the square.
-        const double eps = 1e-6 * fp.cell;
-        for (int v = index(q.y - half_v - eps); v <= index(q.y + half_v + eps); ++v)
-          for (int u = index(q.x - half_u - eps); u <= index(q.x + half_u + eps); ++u)
-            marked[size_t(v) * fp.res + u] = 1;
-      }
-  for (size_t i = 0; i < marked.size(); ++i)
-    if (marked[i]) fp.cells.push_back(uint32_t(i));
-  if (fp.cells.empty() || fp.area() >= 0.9 * kPi * r * r) return std::nullopt;
+  // projection, e the frame's axis s or t; the box lies in the sphere, so in the square.
+  rasterise(majorants, &fp, [&](const Vec3& lo, const Vec3& size, std::vector<uint8_t>* marked) {
+    const Vec3 hs = size * 0.5;
+    const auto half = [&](const Vec3& e) {
+      return std::abs(e.x) * hs.x + std::abs(e.y) * hs.y + std::abs(e.z) * hs.z;
+    };
+    const Vec3 q = fp.frame.to_local(lo + hs - c);
+    const double hu = half(fp.frame.s), hv = half(fp.frame.t);
+    mark(fp, q.x - hu, q.x + hu, q.y - hv, q.y + hv, marked);
+  });
+  fp.share = fp.area() / (kPi * r * r);
+  if (fp.cells.empty() || fp.share >= 0.9) return std::nullopt;
   return fp;
 }
 
-Photon emit_over(const LightFootprint& fp, const Rgb& irradiance, double n, Rng& rng) {
+std::optional<LightFootprint> point_light_footprint(const MajorantGrid& majorants, const Vec3& light,
+                                                    const Vec3& c, double r) {
+  const double dist = (c - light).length();
+  if (majorants.bounds().empty() || !(r > 0.0) || !(dist > r)) return std::nullopt;
+  LightFootprint fp;
+  fp.from_point = true;
+  fp.frame = Frame((c - light) / dist);
+  fp.origin = c;
+  fp.light = light;
+  fp.dist = dist;
+  fp.half = dist * r / std::sqrt(dist * dist - r * r);  // the cone's radius on the plane through c
+  // A cell's box projects from the light inside the rectangle about its 8 corners' projections (the box lies
+  // in the sphere: in front of the light, and inside the cone).
+  rasterise(majorants, &fp, [&](const Vec3& lo, const Vec3& size, std::vector<uint8_t>* marked) {
+    double u0 = 1e300, u1 = -1e300, v0 = 1e300, v1 = -1e300;
+    for (int k = 0; k < 8; ++k) {
+      const Vec3 p = lo + Vec3(k & 1 ? size.x : 0.0, k & 2 ? size.y : 0.0, k & 4 ? size.z : 0.0);
+      const Vec3 q = fp.frame.to_local(p - light);
+      const double u = q.x * dist / q.z, v = q.y * dist / q.z;
+      u0 = std::min(u0, u), u1 = std::max(u1, u), v0 = std::min(v0, v), v1 = std::max(v1, v);
+    }
+    mark(fp, u0, u1, v0, v1, marked);
+  });
+  // The cells' solid angle from the light (each by its centre: the count's share only, not the photons' power).
+  double omega = 0.0;
+  for (const uint32_t i : fp.cells) {
+    const auto [u, v] = cell_centre(fp, i);
+    const double rho = std::sqrt(u * u + v * v + dist * dist);
+    omega += fp.cell * fp.cell * dist / (rho * rho * rho);
+  }
+  fp.share = omega / (2.0 * kPi * (1.0 - std::sqrt(1.0 - r * r / (dist * dist))));
+  if (fp.cells.empty() || fp.share >= 0.9) return std::nullopt;
+  return fp;
+}
+
+Photon emit_over(const LightFootprint& fp, const Rgb& power, double n, Rng& rng) {
   const double u1 = rng.uniform(), u2 = rng.uniform(), u3 = rng.uniform();
   rng.uniform();  // emit's fourth number, not needed here
   const size_t k = std::min(size_t(u3 * double(fp.cells.size())), fp.cells.size() - 1);
   const int u = int(fp.cells[k] % uint32_t(fp.res)), v = int(fp.cells[k] / uint32_t(fp.res));
+  const Vec3 q = fp.frame.to_world({-fp.half + (u + u1) * fp.cell, -fp.half + (v + u2) * fp.cell, 0.0});
   Photon p;
-  p.w = fp.frame.n;
-  p.x = fp.origin + fp.frame.to_world({-fp.r + (u + u1) * fp.cell, -fp.r + (v + u2) * fp.cell, 0.0});
-  p.power = irradiance * (fp.area() / n);
+  if (!fp.from_point) {
+    p.w = fp.frame.n;
+    p.x = fp.origin + q;
+    p.power = power * (fp.area() / n);
+    return p;
+  }
+  const Vec3 to = fp.origin + q - fp.light;
+  const double rho = to.length();
+  p.x = fp.light;
+  p.w = to / rho;
+  p.power = power * (fp.area() * fp.dist / (rho * rho * rho * n));
   return p;
 }
 

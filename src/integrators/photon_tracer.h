@@ -50,28 +50,43 @@ struct Photon {
 Photon emit(const SceneContext& ctx, size_t source, const Vec3& c, double r, double n, Rng& rng,
             const double* strat = nullptr);
 
-// The lines of a directional light's beam that can meet the media: the cells of a raster over the square
-// about emit's disc (normal to the light's direction w, centre c, radius r) onto which some cell of
-// non-zero majorant projects along w (the projection of its box, widened to a rectangle of the raster's
-// axes). A photon of emit's disc on any other line flies past every medium; for a sphere the disc (of
-// the sphere about its bounding box) is three times its cross-section, and on the suite's spheres and
-// the Disney cloud 2/3 to 3/4 of emit's photons met nothing. emit_over draws over the footprint only.
+// The lines of a light's photons that can meet the media. For a directional light (along w): the cells of a
+// raster over the square about emit's disc (normal to w, centre c, radius r) onto which some cell of non-zero
+// majorant projects along w (the projection of its box, widened to a rectangle of the raster's axes). For a
+// point light outside the media's sphere: the cells of a raster over the plane through c normal to the axis a
+// from the light to c, within the cone towards the sphere, onto which such a cell projects from the light (the
+// rectangle about its 8 corners' projections). A photon of emit's on any other line flies past every medium;
+// for a sphere the disc (of the sphere about its bounding box) is three times its cross-section, and on the
+// suite's spheres and the Disney cloud 2/3 to 3/4 of emit's photons met nothing. emit_over draws over the
+// footprint only.
 struct LightFootprint {
-  Frame frame{Vec3(0, 0, 1)};  // about w, as emit's disc
-  Vec3 origin;                 // the disc's centre: c - 2 r w, where emit's photons start
-  double r = 0.0;
+  Frame frame{Vec3(0, 0, 1)};  // about w (directional) or a (point), as emit's disc or cone
+  Vec3 origin{0.0};  // directional: the disc's centre c - 2 r w, where emit's photons start; point: c
+  bool from_point = false;
+  Vec3 light{0.0};              // a point light's position
+  double dist = 0.0;            // from a point light to c
+  double half = 0.0;            // the raster's half side (r; a point light's cone's radius on the plane)
   double cell = 0.0;            // the raster's cell side
-  int res = 0;                  // cells per side (the square [-r, r]^2 of the frame's s, t)
+  int res = 0;                  // cells per side (the square [-half, half]^2 of the frame's s, t)
   std::vector<uint32_t> cells;  // the footprint's cells, v res + u
+  // The share of emit's photons (through the disc; into the cone) whose lines the footprint holds, in
+  // expectation: its area over the disc's; a point light's solid angle over the cone's.
+  double share = 1.0;
   double area() const { return double(cells.size()) * cell * cell; }
 };
-// The footprint of w's beam on the majorant grid's non-empty cells (raster cells of half the grid's
-// smallest cell side, 8 to 512 per side), or none where it covers 90 % of the disc or more.
+// The footprint of a directional light's beam along w, or of a point light at `light` (with `point`) outside
+// the sphere (c, r), on the majorant grid's non-empty cells (raster cells of half the grid's smallest cell
+// side, 8 to 512 per side); none where it covers 90 % of emit's photons or more, or the light is inside the
+// sphere.
 std::optional<LightFootprint> light_footprint(const MajorantGrid& majorants, const Vec3& w, const Vec3& c,
                                               double r);
-// A directional light's photon (irradiance E along the footprint's w), uniform over its cells: power
-// E area / n for n photons. Consumes 4 uniform numbers, as emit.
-Photon emit_over(const LightFootprint& fp, const Rgb& irradiance, double n, Rng& rng);
+std::optional<LightFootprint> point_light_footprint(const MajorantGrid& majorants, const Vec3& light,
+                                                    const Vec3& c, double r);
+// A photon of the footprint's light (irradiance E of a directional light, intensity I of a point light), for n
+// photons: uniform over the footprint's cells, with power E area / n; a point light's towards a uniform point q of
+// them, with power I area dist / (|q - light|^3 n) (the solid angle's density over the plane's). Consumes 4
+// uniform numbers, as emit.
+Photon emit_over(const LightFootprint& fp, const Rgb& power, double n, Rng& rng);
 
 // emit for a scene with surfaces: the light's photons also reach the media by way of the surfaces (the
 // sunlit ground under a cloud lights its base; emit's photons, all aimed at the media's sphere, land only

@@ -315,10 +315,10 @@ struct ScatterPhotons {
   // `pieces`, the full extinction): its majorant is the extinction wherever a tentative collision falls.
   bool exact_pieces;
   std::vector<SourceBlock> blocks;  // per source, as trace numbers them
-  // Per light: a directional light's footprint on the media (light_footprint; none for other lights, with
-  // surfaces, or where it would save little). Its photons are drawn over it, and the light takes the share
-  // area / (pi radius^2) of the photons photon_split gives it: the same photons meet the media, in
-  // expectation, as from emit's whole disc, without those that would fly past them.
+  // Per light: a directional or point light's footprint on the media (light_footprint, point_light_footprint;
+  // none for other lights, with surfaces, or where it would save little). Its photons are drawn over it, and
+  // the light takes the footprint's share of the photons photon_split gives it: the same photons meet the
+  // media, in expectation, as from emit's whole disc or cone, without those that would fly past them.
   std::vector<std::optional<LightFootprint>> footprints{};
   size_t planned = 0;  // photon_split's photons per pass, before the footprints' shares
   // Whether flights are deposited: the pilot (pilot_collisions) only counts collisions, so its tally's
@@ -375,6 +375,13 @@ struct ScatterPhotons {
                     const MediumPoint* at_xc = nullptr) const;
 };
 
+// The power emit_over takes for a light with a footprint: a directional light's irradiance, a point light's
+// intensity.
+Rgb footprint_power(const Light& light) {
+  if (const auto* d = std::get_if<DirectionalLight>(&light)) return d->irradiance;
+  return std::get<PointLight>(light).intensity;
+}
+
 void ScatterPhotons::trace(size_t j, Rng& rng, PhotonBatch& batch) const {
   const size_t per_pass = first.back();
   const int pass = int(j / per_pass);
@@ -392,8 +399,8 @@ void ScatterPhotons::trace(size_t j, Rng& rng, PhotonBatch& batch) const {
   const int first_order = light_like && !from_media ? 1 : 0;
   const int c = pass;  // the channel whose coefficients drive this photon
   const LightFootprint* fp = src < footprints.size() && footprints[src] ? &*footprints[src] : nullptr;
-  const Photon ph = from_media ? emit_from_media(*emission, ctx.media, n, rng)
-                    : fp ? emit_over(*fp, std::get<DirectionalLight>(ctx.lights[src]).irradiance, n, rng)
+  const Photon ph = from_media             ? emit_from_media(*emission, ctx.media, n, rng)
+                    : fp                   ? emit_over(*fp, footprint_power(ctx.lights[src]), n, rng)
                     : ctx.surfaces.empty() ? emit(ctx, source, centre, radius, n, rng)
                                            : emit_with_surfaces(ctx, source, centre, radius, surface, n, rng);
   const SourceBlock& sb = blocks[src];
@@ -704,8 +711,8 @@ constexpr double kDenseCollisions = 3.4;
 constexpr double kMinPhotonFactor = 0.5;
 constexpr double kMaxPhotonFactor = 4.0;
 
-// Per light: light_footprint for a directional light of a scene without surfaces (whose light also reaches
-// the media by way of the surfaces, emit_with_surfaces), else none.
+// Per light: light_footprint for a directional light and point_light_footprint for a point light of a scene
+// without surfaces (whose light also reaches the media by way of the surfaces, emit_with_surfaces), else none.
 std::vector<std::optional<LightFootprint>> light_footprints(const SceneContext& ctx,
                                                             const MajorantGrid& majorants, const Vec3& centre,
                                                             double radius) {
@@ -714,6 +721,8 @@ std::vector<std::optional<LightFootprint>> light_footprints(const SceneContext& 
   for (size_t i = 0; i < ctx.lights.size(); ++i)
     if (const auto* d = std::get_if<DirectionalLight>(&ctx.lights[i]))
       fp[i] = light_footprint(majorants, d->direction, centre, radius);
+    else if (const auto* p = std::get_if<PointLight>(&ctx.lights[i]))
+      fp[i] = point_light_footprint(majorants, p->position, centre, radius);
   return fp;
 }
 
@@ -728,10 +737,8 @@ void ScatterPhotons::split(int photons) {
   std::vector<size_t> count(sources);
   for (size_t i = 0; i < sources; ++i) {
     count[i] = first[i + 1] - first[i];
-    if (i < footprints.size() && footprints[i]) {
-      const double share = footprints[i]->area() / (kPi * radius * radius);
-      count[i] = std::max<size_t>(1, size_t(std::llround(share * double(count[i]))));
-    }
+    if (i < footprints.size() && footprints[i])
+      count[i] = std::max<size_t>(1, size_t(std::llround(footprints[i]->share * double(count[i]))));
   }
   for (size_t i = 0; i < sources; ++i) first[i + 1] = first[i] + count[i];
   if (!ctx.surfaces.empty()) surface = surface_emission(ctx, centre, radius);

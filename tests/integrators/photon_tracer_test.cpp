@@ -145,7 +145,9 @@ TEST(PhotonTracer, LightFootprintHoldsEveryLineThatMeetsTheMedia) {
     ASSERT_TRUE(fp.has_value()) << (sphere ? "sphere" : "box");
     const double disc = kPi * r * r;
     EXPECT_LT(fp->area(), 0.9 * disc);
-    if (sphere) EXPECT_GT(fp->area(), kPi);
+    if (sphere) {
+      EXPECT_GT(fp->area(), kPi);
+    }
     const auto in_footprint = [&](double x, double y) {
       const int u = int(std::floor((x + r) / fp->cell)), v = int(std::floor((y + r) / fp->cell));
       return std::binary_search(fp->cells.begin(), fp->cells.end(), uint32_t(v * fp->res + u));
@@ -176,6 +178,71 @@ TEST(PhotonTracer, LightFootprintHoldsEveryLineThatMeetsTheMedia) {
       EXPECT_NEAR((p.w - w).length(), 0.0, 1e-12);
       EXPECT_NEAR(p.power.x * 1000.0, 2.0 * fp->area(), 1e-9 * fp->area());
     }
+  }
+}
+
+// A point light's footprint (point_light_footprint) holds every direction from the light that meets the media
+// (200 000 directions of the cone towards the media's sphere, tested against a sphere and a box), and
+// emit_over's photons, whose power varies with their direction, carry the light's power into the sphere: the
+// photons that hit it sum to I times its solid angle from the light, within 4 standard errors.
+TEST(PhotonTracer, PointLightFootprintHoldsEveryLineThatMeetsTheMedia) {
+  const Vec3 light(4.0, 1.5, -1.0), centre(0.5, 0, 0);
+  for (const bool sphere : {true, false}) {
+    const std::string shape = sphere ? R"({"type": "sphere", "center": [0.5, 0, 0], "radius": 1})"
+                                     : R"({"type": "box", "min": [-1, -0.5, -0.25], "max": [1, 0.5, 0.25]})";
+    const Scene scene = test::scene_from_json("{" + test::camera_json(8, 8) + R"(, "media": [{"shape": )" +
+                                              shape + R"(, "sigma_s": 0.9, "sigma_a": 0.1}],
+      "lights": [{"type": "point", "position": [4, 1.5, -1], "intensity": 1.0}]})");
+    const SceneContext ctx(scene);
+    const Bounds b = ctx.media.bounds();
+    const Vec3 c = (b.lo + b.hi) * 0.5;
+    const double r = 0.5 * (b.hi - b.lo).length() * (1.0 + 1e-9);
+    const std::optional<LightFootprint> fp = point_light_footprint(ctx.majorants, light, c, r);
+    ASSERT_TRUE(fp.has_value()) << (sphere ? "sphere" : "box");
+    EXPECT_LT(fp->share, 0.9);
+    const auto meets = [&](const Vec3& w) {
+      double t0 = 0.0, t1 = 0.0;
+      if (!sphere) return b.intersect(light, w, 0.0, 1e9, &t0, &t1);
+      const Vec3 oc = light - centre;
+      const double along = -dot(oc, w);
+      return along > 0.0 && (oc + w * along).length() < 1.0;
+    };
+    const auto in_footprint = [&](const Vec3& w) {
+      const Vec3 q = fp->frame.to_local(w);
+      const double x = q.x * fp->dist / q.z, y = q.y * fp->dist / q.z;
+      const int u = int(std::floor((x + fp->half) / fp->cell)),
+                v = int(std::floor((y + fp->half) / fp->cell));
+      return std::binary_search(fp->cells.begin(), fp->cells.end(), uint32_t(v * fp->res + u));
+    };
+    const double dist = (c - light).length(), cos_max = std::sqrt(1.0 - r * r / (dist * dist));
+    int meeting = 0, missed = 0;
+    Rng rng(7, 0);
+    for (int j = 0; j < 200000; ++j) {
+      const Vec3 w = spherical_direction(1.0 - rng.uniform() * (1.0 - cos_max), 2.0 * kPi * rng.uniform(),
+                                         (c - light) / dist);
+      if (!meets(w)) continue;
+      ++meeting;
+      missed += !in_footprint(w);
+    }
+    EXPECT_GT(meeting, 10000);
+    EXPECT_EQ(missed, 0) << (sphere ? "sphere" : "box");
+    if (!sphere) continue;
+    // The power into the unit sphere at distance d: I 2 pi (1 - sqrt(1 - 1 / d^2)).
+    constexpr int kPhotons = 200000;
+    double sum = 0.0, sum2 = 0.0;
+    for (int j = 0; j < kPhotons; ++j) {
+      Rng prng(9, uint64_t(j));
+      const Photon p = emit_over(*fp, Rgb(1.0), double(kPhotons), prng);
+      EXPECT_EQ(p.x, light);
+      const double x = meets(p.w) ? p.power.x : 0.0;
+      sum += x;
+      sum2 += x * x;
+    }
+    const double d = (centre - light).length();
+    const double expected = 2.0 * kPi * (1.0 - std::sqrt(1.0 - 1.0 / (d * d)));
+    const double se = std::sqrt(std::max(0.0, sum2 - sum * sum / kPhotons));  // of the sum
+    EXPECT_NEAR(sum, expected, 4.0 * se) << "se " << se;
+    EXPECT_LT(se, 0.01 * expected);
   }
 }
 
