@@ -125,6 +125,20 @@ TEST(PhotonTracer, GridsOfAUsualSceneHaveNoRejectionFailures) {
   EXPECT_EQ(mfs.beam_grid()->rejection_failures(), 0u);
 }
 
+// The footprint tests' scene: a unit sphere about (0.5, 0, 0) or a flat box, and one light (JSON), with the
+// sphere about the media's bounding box (centre *c, radius *r) that ScatterGrid aims its photons at.
+Scene footprint_scene(bool sphere, const std::string& light) {
+  const std::string shape = sphere ? R"({"type": "sphere", "center": [0.5, 0, 0], "radius": 1})"
+                                   : R"({"type": "box", "min": [-1, -0.5, -0.25], "max": [1, 0.5, 0.25]})";
+  return test::scene_from_json("{" + test::camera_json(8, 8) + R"(, "media": [{"shape": )" + shape +
+                               R"(, "sigma_s": 0.9, "sigma_a": 0.1}], "lights": [)" + light + "]}");
+}
+void bounding_sphere(const SceneContext& ctx, Vec3* c, double* r) {
+  const Bounds b = ctx.media.bounds();
+  *c = (b.lo + b.hi) * 0.5;
+  *r = 0.5 * (b.hi - b.lo).length() * (1.0 + 1e-9);
+}
+
 // A directional light's footprint (light_footprint) holds every line of emit's disc that meets a medium:
 // lines through 200 000 uniform points of the disc, tested against the shape itself, for a sphere and for
 // a box, lit obliquely. It is smaller than the disc (a sphere's: at most 0.9 of it, at least its own
@@ -132,15 +146,12 @@ TEST(PhotonTracer, GridsOfAUsualSceneHaveNoRejectionFailures) {
 TEST(PhotonTracer, LightFootprintHoldsEveryLineThatMeetsTheMedia) {
   const Vec3 w = normalize(Vec3(1.0, 0.3, -0.2));
   for (const bool sphere : {true, false}) {
-    const std::string shape = sphere ? R"({"type": "sphere", "center": [0.5, 0, 0], "radius": 1})"
-                                     : R"({"type": "box", "min": [-1, -0.5, -0.25], "max": [1, 0.5, 0.25]})";
-    const Scene scene = test::scene_from_json("{" + test::camera_json(8, 8) + R"(, "media": [{"shape": )" +
-                                              shape + R"(, "sigma_s": 0.9, "sigma_a": 0.1}],
-      "lights": [{"type": "directional", "direction": [1, 0, 0], "irradiance": 1.0}]})");
-    const SceneContext ctx(scene);
+    const SceneContext ctx(
+        footprint_scene(sphere, R"({"type": "directional", "direction": [1, 0, 0], "irradiance": 1.0})"));
     const Bounds b = ctx.media.bounds();
-    const Vec3 c = (b.lo + b.hi) * 0.5;
-    const double r = 0.5 * (b.hi - b.lo).length() * (1.0 + 1e-9);
+    Vec3 c;
+    double r = 0.0;
+    bounding_sphere(ctx, &c, &r);
     const std::optional<LightFootprint> fp = light_footprint(ctx.majorants, w, c, r);
     ASSERT_TRUE(fp.has_value()) << (sphere ? "sphere" : "box");
     const double disc = kPi * r * r;
@@ -188,15 +199,12 @@ TEST(PhotonTracer, LightFootprintHoldsEveryLineThatMeetsTheMedia) {
 TEST(PhotonTracer, PointLightFootprintHoldsEveryLineThatMeetsTheMedia) {
   const Vec3 light(4.0, 1.5, -1.0), centre(0.5, 0, 0);
   for (const bool sphere : {true, false}) {
-    const std::string shape = sphere ? R"({"type": "sphere", "center": [0.5, 0, 0], "radius": 1})"
-                                     : R"({"type": "box", "min": [-1, -0.5, -0.25], "max": [1, 0.5, 0.25]})";
-    const Scene scene = test::scene_from_json("{" + test::camera_json(8, 8) + R"(, "media": [{"shape": )" +
-                                              shape + R"(, "sigma_s": 0.9, "sigma_a": 0.1}],
-      "lights": [{"type": "point", "position": [4, 1.5, -1], "intensity": 1.0}]})");
-    const SceneContext ctx(scene);
+    const SceneContext ctx(
+        footprint_scene(sphere, R"({"type": "point", "position": [4, 1.5, -1], "intensity": 1.0})"));
     const Bounds b = ctx.media.bounds();
-    const Vec3 c = (b.lo + b.hi) * 0.5;
-    const double r = 0.5 * (b.hi - b.lo).length() * (1.0 + 1e-9);
+    Vec3 c;
+    double r = 0.0;
+    bounding_sphere(ctx, &c, &r);
     const std::optional<LightFootprint> fp = point_light_footprint(ctx.majorants, light, c, r);
     ASSERT_TRUE(fp.has_value()) << (sphere ? "sphere" : "box");
     EXPECT_LT(fp->share, 0.9);
