@@ -123,10 +123,10 @@ void rasterise(const MajorantGrid& majorants, LightFootprint* fp, Rect&& rect) {
     if (marked[i]) fp->cells.push_back(uint32_t(i));
 }
 
-// Cell i's centre in the plane's coordinates.
-std::pair<double, double> cell_centre(const LightFootprint& fp, uint32_t i) {
+// The point at fractions (a, b) of cell i (v res + u), in the plane's coordinates.
+std::pair<double, double> cell_point(const LightFootprint& fp, uint32_t i, double a, double b) {
   const int u = int(i % uint32_t(fp.res)), v = int(i / uint32_t(fp.res));
-  return {-fp.half + (u + 0.5) * fp.cell, -fp.half + (v + 0.5) * fp.cell};
+  return {-fp.half + (u + a) * fp.cell, -fp.half + (v + b) * fp.cell};
 }
 
 }  // namespace
@@ -180,7 +180,7 @@ std::optional<LightFootprint> point_light_footprint(const MajorantGrid& majorant
   // The cells' solid angle from the light (each by its centre: the count's share only, not the photons' power).
   double omega = 0.0;
   for (const uint32_t i : fp.cells) {
-    const auto [u, v] = cell_centre(fp, i);
+    const auto [u, v] = cell_point(fp, i, 0.5, 0.5);
     const double rho = std::sqrt(u * u + v * v + dist * dist);
     omega += fp.cell * fp.cell * dist / (rho * rho * rho);
   }
@@ -193,8 +193,8 @@ Photon emit_over(const LightFootprint& fp, const Rgb& power, double n, Rng& rng)
   const double u1 = rng.uniform(), u2 = rng.uniform(), u3 = rng.uniform();
   rng.uniform();  // emit's fourth number, not needed here
   const size_t k = std::min(size_t(u3 * double(fp.cells.size())), fp.cells.size() - 1);
-  const int u = int(fp.cells[k] % uint32_t(fp.res)), v = int(fp.cells[k] / uint32_t(fp.res));
-  const Vec3 q = fp.frame.to_world({-fp.half + (u + u1) * fp.cell, -fp.half + (v + u2) * fp.cell, 0.0});
+  const auto [x, y] = cell_point(fp, fp.cells[k], u1, u2);
+  const Vec3 q = fp.frame.to_world({x, y, 0.0});
   Photon p;
   if (!fp.from_point) {
     p.w = fp.frame.n;

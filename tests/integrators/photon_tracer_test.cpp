@@ -133,6 +133,11 @@ Scene footprint_scene(bool sphere, const std::string& light) {
   return test::scene_from_json("{" + test::camera_json(8, 8) + R"(, "media": [{"shape": )" + shape +
                                R"(, "sigma_s": 0.9, "sigma_a": 0.1}], "lights": [)" + light + "]}");
 }
+// Whether the footprint's raster cell that holds plane point (x, y) is one of its cells.
+bool in_cells(const LightFootprint& fp, double x, double y) {
+  const int u = int(std::floor((x + fp.half) / fp.cell)), v = int(std::floor((y + fp.half) / fp.cell));
+  return std::binary_search(fp.cells.begin(), fp.cells.end(), uint32_t(v * fp.res + u));
+}
 void bounding_sphere(const SceneContext& ctx, Vec3* c, double* r) {
   const Bounds b = ctx.media.bounds();
   *c = (b.lo + b.hi) * 0.5;
@@ -159,10 +164,7 @@ TEST(PhotonTracer, LightFootprintHoldsEveryLineThatMeetsTheMedia) {
     if (sphere) {
       EXPECT_GT(fp->area(), kPi);
     }
-    const auto in_footprint = [&](double x, double y) {
-      const int u = int(std::floor((x + r) / fp->cell)), v = int(std::floor((y + r) / fp->cell));
-      return std::binary_search(fp->cells.begin(), fp->cells.end(), uint32_t(v * fp->res + u));
-    };
+    const auto in_footprint = [&](double x, double y) { return in_cells(*fp, x, y); };
     int meeting = 0, missed = 0;
     Rng rng(5, 0);
     for (int j = 0; j < 200000; ++j) {
@@ -217,10 +219,7 @@ TEST(PhotonTracer, PointLightFootprintHoldsEveryLineThatMeetsTheMedia) {
     };
     const auto in_footprint = [&](const Vec3& w) {
       const Vec3 q = fp->frame.to_local(w);
-      const double x = q.x * fp->dist / q.z, y = q.y * fp->dist / q.z;
-      const int u = int(std::floor((x + fp->half) / fp->cell)),
-                v = int(std::floor((y + fp->half) / fp->cell));
-      return std::binary_search(fp->cells.begin(), fp->cells.end(), uint32_t(v * fp->res + u));
+      return in_cells(*fp, q.x * fp->dist / q.z, q.y * fp->dist / q.z);
     };
     const double dist = (c - light).length(), cos_max = std::sqrt(1.0 - r * r / (dist * dist));
     int meeting = 0, missed = 0;
