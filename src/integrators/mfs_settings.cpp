@@ -317,6 +317,7 @@ ScatterGridSettings scatter_grid_settings(const MfsSettings& s, bool adaptive, u
   ScatterGridSettings grid;
   grid.photons = *s.photons;
   grid.adaptive_photons = adaptive ? grid.photons : 0;  // the image size's count, times the pilot's factor
+  grid.pilot = !s.beam_photons;                         // "auto" beam photons read the pilot's collisions
   grid.resolution = *s.scatter_grid_resolution;
   grid.max_wide_scatters = s.large_angle_scatters.value_or(0);
   grid.exact_transport = s.photon_transport == PhotonTransport::exact;

@@ -727,7 +727,7 @@ std::vector<std::optional<LightFootprint>> light_footprints(const SceneContext& 
 }
 
 // Whether a pilot sets the count.
-bool wants_pilot(const ScatterGridSettings& s) { return s.adaptive_photons > 0; }
+bool wants_pilot(const ScatterGridSettings& s) { return s.adaptive_photons > 0 || s.pilot; }
 
 void ScatterPhotons::split(int photons) {
   if (footprints.empty())
@@ -873,7 +873,7 @@ void ScatterGrid::trace(const SceneContext& ctx, const std::vector<const PhaseSp
       assign_blocks(ctx, grey, lights, sources, grid_.size(), coeffs_, &photons.blocks, &rgb_size);
   if (wants_pilot(s)) {
     collisions_per_photon_ = pilot_collisions(photons, tally_size);
-    photons_ = adaptive_photon_count(s, *collisions_per_photon_);
+    if (s.adaptive_photons > 0) photons_ = adaptive_photon_count(s, *collisions_per_photon_);
   }
   photons.split(photons_);
   const size_t total = size_t(passes) * photons.first.back();

@@ -60,6 +60,9 @@ struct ScatterGridSettings {
   // collisions in dense media"). `mfs`'s "auto" photons: its image size's count (auto_photons), so the two
   // factors multiply; 0 for a count given.
   int adaptive_photons = 0;
+  // Run the pilot and report its collisions per photon (collisions_per_photon) for a count given too:
+  // `mfs`'s "auto" beam photons read them (auto_beam_photons: thin media take more), whatever `photons` is.
+  bool pilot = false;
   // Chromatic media: one photon pass per channel, each with that channel's coefficients (true), or one
   // pass of hero-channel photons carrying all three (false; scatter_grid.cpp's HeroWalk). Grey media
   // take one pass either way.
@@ -142,7 +145,7 @@ class ScatterGrid {
   uint64_t rejection_failures() const { return rejection_failures_; }
   // The photons traced per pass (settings.photons, or what adaptive_photons made of it).
   int photons() const { return photons_; }
-  // The pilot's real and null collisions per photon (adaptive_photons), if it ran.
+  // The pilot's real and null collisions per photon (adaptive_photons or pilot), if it ran.
   std::optional<double> collisions_per_photon() const { return collisions_per_photon_; }
 
   size_t memory_bytes() const {

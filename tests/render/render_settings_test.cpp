@@ -167,9 +167,10 @@ TEST(RenderSettings, AutoPhotonsHalfWhereTheCameraLooksIntoTheForwardPeak) {
 // "auto" beam photons in thin media (the scatter grid pilot's collisions per photon below 1.2): 2^15
 // sqrt(pixels / 128^2) for every light, seen from the side too. A side-lit sphere of optical radius 0.3
 // traces 2^16 in a crop of a 256 x 256 image and 2^15 at 8 x 6; one of radius 10 (~4 collisions per photon)
-// 2^15; with the scatter grid's photons given (no pilot) 2^15. With a spot light beside the sun (which the beam
-// grid does not trace) the header holds one count too, and the scene in the header (its photons given, so no
-// pilot: "auto" could not be resolved again) renders the same image.
+// 2^14; with the scatter grid's photons given the same 2^16 (the pilot still runs for the beam count: the
+// grid's photons given do not change the beam grid). With a spot light beside the sun (which the beam grid
+// does not trace) the header holds one count too, and the scene in the header (both counts given: no pilot)
+// renders the same image.
 TEST(RenderSettings, AutoBeamPhotonsFollowThePixelsInThinMedia) {
   const std::string sun = R"({"type": "directional", "direction": [-1, 0.3, 0.2], "irradiance": 1.0})";
   const auto scene = [&](double sigma_s, int size, const std::string& photons, const std::string& lights) {
@@ -185,7 +186,8 @@ TEST(RenderSettings, AutoBeamPhotonsFollowThePixelsInThinMedia) {
   EXPECT_EQ(render(scene(0.3, 256, "\"auto\"", sun), crop).settings["beam_photons"], 1 << 16);
   EXPECT_EQ(render(scene(0.3, 8, "\"auto\"", sun)).settings["beam_photons"], 1 << 15);
   EXPECT_EQ(render(scene(10.0, 256, "\"auto\"", sun), crop).settings["beam_photons"], 1 << 14);
-  EXPECT_EQ(render(scene(0.3, 256, "4096", sun), crop).settings["beam_photons"], 1 << 14);
+  EXPECT_EQ(render(scene(0.3, 256, "4096", sun), crop).settings["beam_photons"], 1 << 16);
+  EXPECT_EQ(render(scene(10.0, 256, "4096", sun), crop).settings["beam_photons"], 1 << 14);
   const std::string spot =
       R"({"type": "spot", "position": [0.5, 6, 0], "direction": [0, -1, 0], "intensity": 10.0, "cone_angle_deg": 60})";
   const RenderResult first = render(scene(0.3, 256, "\"auto\"", sun + ", " + spot), crop);
@@ -205,11 +207,12 @@ TEST(RenderSettings, AutoBeamPhotonsFollowThePixelsInThinMedia) {
 // backlit sphere traces 2^16 (2048 x 2048: 2^18, the most) and the 8 x 8 image 2^15; a side-lit sphere and a
 // spot light (which the beam grid does not trace) 2^14 (8 x 8: 2^13, 2048 x 2048: 2^15, the most), a camera
 // inside the media 2^16 for any light; with lights of both kinds the header says "auto" (and renders the same
-// image again); a count given is kept.
+// image again); a count given is kept. (The sphere, of optical radius 10, is not thin: AutoBeamPhotonsFollowThe
+// PixelsInThinMedia.)
 TEST(RenderSettings, AutoBeamPhotonsFollowThePixelsWhereTheCameraLooksIntoTheForwardPeak) {
   const auto scene = [](const std::string& lights, int size) {
     return test::scene_from_json("{" + test::camera_json(size, size) + R"(,
-      "media": [{"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1}, "sigma_s": 2.0,
+      "media": [{"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1}, "sigma_s": 10.0,
                  "phase": {"type": "hg", "g": 0.8}}],
       "lights": [)" + lights + R"(],
       "integrator": {"type": "mfs", "spp": 1, "photons": 4096, "scatter_grid_resolution": 8}})");
