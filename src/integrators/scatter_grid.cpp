@@ -730,8 +730,12 @@ std::vector<std::optional<LightFootprint>> light_footprints(const SceneContext& 
 bool wants_pilot(const ScatterGridSettings& s) { return s.adaptive_photons > 0 || s.pilot; }
 
 void ScatterPhotons::split(int photons) {
-  if (footprints.empty())
+  // The traced lights' footprints only, sources 0 .. lights - 1: with K = 1 the grid traces no light, and its
+  // source 0 is the environment.
+  if (footprints.empty() && lights > 0) {
     footprints = light_footprints(ctx, s.majorants ? *s.majorants : ctx.majorants, centre, radius);
+    footprints.resize(lights);
+  }
   first = photon_split(ctx, emission, s, photons, lights, sources, centre, radius);
   planned = first.back();
   std::vector<size_t> count(sources);

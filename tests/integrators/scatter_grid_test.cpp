@@ -143,6 +143,47 @@ TEST(ScatterGrid, LiveNodesOnlyKeepTheMediaBitForBit) {
   EXPECT_EQ(gap_live[0], 0.0);
 }
 
+// With K = 1 (max_wide_scatters 1) the grid holds the environment's light only (the lights' first wide scatter
+// is the camera march's): a sun beside the sky changes nothing, bit for bit. (The sun's footprint once stood
+// for the sky's photons there: its light entered the grid from its entry.)
+TEST(ScatterGrid, FirstOrderOnlyHoldsTheEnvironmentAlone) {
+  const auto grid_of = [](bool sun) {
+    const Scene scene = test::scene_from_json(
+        "{" + test::camera_json(8, 8, 40.0) + R"(,
+      "media": [{"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1}, "sigma_s": 4.0, "sigma_a": 0.1,
+                 "phase": {"type": "hg", "g": 0.8}}],
+      "lights": [)" +
+        std::string(sun ? R"({"type": "directional", "direction": [-1, 0.3, 0.2], "irradiance": 3.0},)"
+                        : "") +
+        R"({"type": "environment", "radiance": 0.1}]})");
+    const SceneContext ctx(scene);
+    const Phase& phase = ctx.media.phase(0);
+    const PhaseSplit split(phase, auto_peak_fraction(phase));
+    ScatterGridSettings s;
+    s.photons = 4096;
+    s.resolution = 12;
+    s.max_wide_scatters = 1;
+    const ScatterGrid grid(ctx, {&split}, {split.f()}, s);
+    std::array<Rgb, kShMaxBands> chi;
+    for (int l = 0; l < kShMaxBands; ++l) chi[l] = Rgb(std::pow(0.5, l));
+    std::vector<double> v;
+    Rng rng(5, 0);
+    for (int i = 0; i < 200; ++i) {
+      const Vec3 p(1.4 * rng.uniform() - 0.7, 1.4 * rng.uniform() - 0.7, 1.4 * rng.uniform() - 0.7);
+      const Vec3 w = normalize(Vec3(rng.uniform() - 0.5, rng.uniform() - 0.5, rng.uniform() - 0.5));
+      v.push_back(luminance(grid.scattered(p, w, chi)));
+    }
+    return v;
+  };
+  const std::vector<double> sky = grid_of(false), both = grid_of(true);
+  double sum = 0.0;
+  for (size_t i = 0; i < sky.size(); ++i) {
+    ASSERT_EQ(both[i], sky[i]) << i;
+    sum += sky[i];
+  }
+  EXPECT_GT(sum, 0.0);
+}
+
 // The stochastic splats (one node per deposit sample, drawn by its trilinear weight) keep the grid's
 // mean: the same photons (the same seed: the walks do not depend on the splat) deposited trilinearly and
 // stochastically, over seeds; the paired differences' mean is 0 within 4 of its standard errors. And
