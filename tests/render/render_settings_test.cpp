@@ -207,8 +207,8 @@ TEST(RenderSettings, AutoBeamPhotonsFollowThePixelsInThinMedia) {
 // backlit sphere traces 2^16 (2048 x 2048: 2^18, the most) and the 8 x 8 image 2^15; a side-lit sphere and a
 // spot light (which the beam grid does not trace) 2^14 (8 x 8: 2^13, 2048 x 2048: 2^15, the most), a camera
 // inside the media 2^16 for any light; with lights of both kinds the header says "auto" (and renders the same
-// image again); a count given is kept. (The sphere, of optical radius 10, is not thin: AutoBeamPhotonsFollowThe
-// PixelsInThinMedia.)
+// image again); a count given is kept. (The sphere, of optical radius 10, is not thin; thin media: the test
+// above.)
 TEST(RenderSettings, AutoBeamPhotonsFollowThePixelsWhereTheCameraLooksIntoTheForwardPeak) {
   const auto scene = [](const std::string& lights, int size) {
     return test::scene_from_json("{" + test::camera_json(size, size) + R"(,
