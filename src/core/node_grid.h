@@ -132,14 +132,24 @@ inline NodeGrid node_grid_spanning(const Bounds& b, int resolution) {
 }
 
 // Nodes covering the media's bounds, plus one spacing of padding on each side so every point of the
-// media has a node's full support around it; `resolution` nodes along the longest axis (a flat axis
-// gets a spacing of 1e-6 of the longest). The scatter and beam grids' layout.
-inline NodeGrid node_grid_padded(const Bounds& media_bounds, int resolution) {
+// media has a node's full support around it; `resolution` nodes along the longest axis and proportionally
+// fewer along the others (a flat axis gets a spacing of 1e-6 of the longest). The scatter and beam grids'
+// layout. With `sigma`, the media's typical extinction, an axis shorter than a quarter of the longest gets at
+// least one node per kFlatAxisDepth optical depths of its extent (at most `resolution`): across a wide layer
+// the light changes over a few transport lengths however wide the layer is, and the proportional count gave
+// an 80 x 80 x 4 layer of 16 optical depths 4 nodes across it, 6 % dark (docs/benchmarks.md, "A flat
+// layer"). Axes of a quarter of the longest or more keep the proportional count (the suite's spheres, box and
+// clouds: their grids are unchanged).
+inline constexpr double kFlatAxisDepth = 1.6;
+inline NodeGrid node_grid_padded(const Bounds& media_bounds, int resolution, double sigma = 0.0) {
   NodeGrid g;
   const Vec3 extent = media_bounds.hi - media_bounds.lo;
   const double longest = std::max({extent.x, extent.y, extent.z});
   for (int a = 0; a < 3; ++a) {
-    const int inner = std::max(2, int(std::ceil(extent[a] / longest * (resolution - 1))) + 1);
+    int inner = std::max(2, int(std::ceil(extent[a] / longest * (resolution - 1))) + 1);
+    if (sigma > 0.0 && extent[a] < 0.25 * longest && std::isfinite(extent[a] * sigma))
+      inner = std::max(inner,
+                       int(std::min(double(resolution), std::ceil(extent[a] * sigma / kFlatAxisDepth))) + 1);
     g.spacing[a] = std::max(extent[a], 1e-6 * longest) / (inner - 1);
     g.nodes[a] = inner + 2;
     g.bounds.lo[a] = media_bounds.lo[a] - g.spacing[a];

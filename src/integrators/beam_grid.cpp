@@ -484,7 +484,7 @@ BeamGrid::BeamGrid(const SceneContext& ctx, const std::vector<const PhaseSplit*>
       reduced_maps.size() != ctx.lights.size() || full_maps.size() != ctx.lights.size() || splits.empty())
     return;
   one_minus_chi1_ = 1.0 - (splits[0]->peak_moments().size() > 1 ? splits[0]->peak_moments()[1] : 1.0);
-  grid_ = node_grid_padded(media_bounds, resolution);
+  grid_ = node_grid_padded(media_bounds, resolution, ctx.majorants.mean_majorant());
   const bool grey = grey_media(ctx);
   channels_ = grey && grey_lights(ctx) ? 1 : 3;
   const Blocks blocks{.spread = spread, .pk = with_camera_, .wide = with_wide_};

@@ -164,15 +164,8 @@ double pixel_scale(const PinholeCamera& camera) {
 // (6 seeds; docs/benchmarks.md, "The scatter grid denoised").
 int auto_scatter_grid_resolution(const SceneContext& ctx) {
   const Bounds b = ctx.media.bounds();
-  double sum = 0.0;
-  size_t cells = 0;
-  const auto res = ctx.majorants.resolution();
-  for (int z = 0; z < res[2]; ++z)
-    for (int y = 0; y < res[1]; ++y)
-      for (int x = 0; x < res[0]; ++x)
-        if (const double m = ctx.majorants.cell_majorant(x, y, z); m > 0.0) sum += m, ++cells;
   const Vec3 e = b.empty() ? Vec3(0.0) : b.hi - b.lo;
-  const double across = cells > 0 ? std::max({e.x, e.y, e.z}) * sum / double(cells) : 0.0;
+  const double across = std::max({e.x, e.y, e.z}) * ctx.majorants.mean_majorant();
   const double nodes = std::isfinite(across) ? std::clamp(std::ceil(across / 1.6), 32.0, 64.0) : 64.0;
   const double scale = std::min(1.0, (24.0 + 4.0 * std::log2(pixel_scale(ctx.camera))) / 32.0);
   return int(std::round(nodes * scale));

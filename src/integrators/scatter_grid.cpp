@@ -823,7 +823,7 @@ ScatterGrid::ScatterGrid(const SceneContext& ctx, const std::vector<const PhaseS
     values_.assign(grid_.size() * channels_ * coeffs_, 0.0f);  // the default grid: 2^3 nodes over [0, 1]^3
     return;
   }
-  grid_ = node_grid_padded(media_bounds, s.resolution > 0 ? s.resolution : 32);
+  grid_ = node_grid_padded(media_bounds, s.resolution > 0 ? s.resolution : 32, ctx.majorants.mean_majorant());
   // With K = 1 only the environment's unscattered-by-wide light is needed (see the header).
   if (!(s.max_wide_scatters == 1 && !ctx.has_environment && !ctx.media.emits()))
     trace(ctx, splits, peak_fraction, s);

@@ -29,6 +29,14 @@ class MajorantGrid {
   const Bounds& bounds() const { return bounds_; }
   std::array<int, 3> resolution() const { return res_; }
   double cell_majorant(int x, int y, int z) const { return maj_[(size_t(z) * res_[1] + y) * res_[0] + x]; }
+  // The mean majorant of the non-empty cells (0 when every cell is empty): the media's typical extinction.
+  double mean_majorant() const {
+    double sum = 0.0;
+    size_t cells = 0;
+    for (const double m : maj_)
+      if (m > 0.0) sum += m, ++cells;
+    return cells > 0 ? sum / double(cells) : 0.0;
+  }
   // Whether a medium may emit in the cell that holds p (clamped to the grid; SceneMedia::may_emit).
   bool may_emit_at(const Vec3& p) const;
   size_t memory_bytes() const { return maj_.size() * sizeof(float) + emits_.size(); }

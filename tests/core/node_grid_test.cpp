@@ -62,6 +62,28 @@ TEST(NodeGrid, PaddedLayoutCoversTheMediaWithOneSpacingToSpare) {
   EXPECT_DOUBLE_EQ(g.cell_volume(), g.spacing.x * g.spacing.y * g.spacing.z);
 }
 
+// An axis under a quarter of the longest gets at least a node per kFlatAxisDepth optical depths of its extent
+// (at most `resolution`): an 80 x 80 x 4 layer of extinction 4 (16 optical depths across) 11 nodes across its
+// thickness instead of 4; its long axes, a cube's axes and an axis of 0.3 of the longest keep their
+// proportional counts; a flat axis of no extent stays at 2; the padding is one spacing as ever.
+TEST(NodeGrid, AFlatAxisGetsANodePerFewOpticalDepths) {
+  const Bounds layer{Vec3(-40.0, -40.0, -2.0), Vec3(40.0, 40.0, 2.0)};
+  const NodeGrid plain = node_grid_padded(layer, 48), floored = node_grid_padded(layer, 48, 4.0);
+  EXPECT_EQ(plain.nodes[2], 4 + 2);
+  EXPECT_EQ(floored.nodes[2], 11 + 2);
+  EXPECT_NEAR(floored.spacing.z * 10.0, 4.0, 1e-12);
+  EXPECT_NEAR(floored.bounds.lo.z, -2.0 - floored.spacing.z, 1e-12);
+  for (int a = 0; a < 2; ++a) EXPECT_EQ(floored.nodes[a], plain.nodes[a]);
+  EXPECT_EQ(node_grid_padded(layer, 48, 1000.0).nodes[2], 49 + 2);  // at most `resolution` + 1 inner nodes
+  const Bounds cube{Vec3(0.0), Vec3(10.0)}, slab3{Vec3(0.0), Vec3(10.0, 10.0, 3.0)};
+  for (int a = 0; a < 3; ++a) {
+    EXPECT_EQ(node_grid_padded(cube, 24, 100.0).nodes[a], node_grid_padded(cube, 24).nodes[a]);
+    EXPECT_EQ(node_grid_padded(slab3, 24, 100.0).nodes[a], node_grid_padded(slab3, 24).nodes[a]);
+  }
+  const Bounds sheet{Vec3(0.0), Vec3(10.0, 10.0, 0.0)};
+  EXPECT_EQ(node_grid_padded(sheet, 24, 100.0).nodes[2], 2 + 2);
+}
+
 TEST(NodeGrid, TrilinearWeightsSumToOneAndReproduceLinearFunctions) {
   const NodeGrid g = node_grid_padded(Bounds{Vec3(-1.0, 0.5, 2.0), Vec3(2.0, 1.5, 4.0)}, 7);
   const std::vector<double> values = sample_nodes(g, linear);
